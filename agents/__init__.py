@@ -1,0 +1,1 @@
+"""agents: PPO baseline and scripted extraction schedules (not implemented yet; needs boom_env)."""

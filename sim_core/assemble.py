@@ -1,0 +1,101 @@
+"""Scene -> Model: only the effects a scene switches on are built into the model."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .beam.moving_node_beam import Beam, BeamSection
+from .effects import Effect, Elasticity, Gravity, Inertia, PointLoad, StressFilter
+from .model import LinearConstraint, Model, boundary_condition
+
+
+def beam_section(sec: dict) -> BeamSection:
+    """BeamSection from scene section data (E, G, rho, A, I_t, I_b, J, I_p)."""
+    rho = sec["rho"]
+    rot = sec.get("rotary_bending", True)
+    return BeamSection(EA=sec["E"] * sec["A"], GJ=sec["G"] * sec["J"], EI_t=sec["E"] * sec["I_t"],
+                       EI_b=sec["E"] * sec["I_b"], rhoA=rho * sec["A"], J_s=rho * sec["I_p"],
+                       J_t=rho * sec["I_t"] if rot else 0.0, J_b=rho * sec["I_b"] if rot else 0.0)
+
+
+def reference_basis(direction) -> np.ndarray:
+    """Cardan reference basis with g3 along the beam axis and g1 normal to it (horizontal if
+    possible), so that the singular direction e_s = g1 is 90 degrees away (Section 5)."""
+    d = np.asarray(direction, float)
+    d = d / np.linalg.norm(d)
+    up = np.array([0.0, 0.0, 1.0])
+    g1 = np.cross(up, d) if abs(d @ up) < 0.99 else np.array([0.0, 1.0, 0.0])
+    g1 = g1 / np.linalg.norm(g1)
+    if g1 @ np.array([0.0, 1.0, 0.0]) < 0:
+        g1 = -g1
+    g2 = np.cross(d, g1)
+    return np.column_stack([g1, g2, d])
+
+
+def build_model(scene: dict) -> tuple[Model, np.ndarray, np.ndarray]:
+    """Model and its initial full state (Q0, Q0_dot) from a validated scene."""
+    beams = [Beam(b["name"], b["length"], beam_section(b["section"]), tuple(b["breakpoints"]),
+                  n_nodes=b["n_nodes"], n_gauss=b["n_gauss"],
+                  reference_basis=reference_basis(b["direction"]))
+             for b in scene["beams"]]
+    offsets = np.cumsum([0] + [b.n_coords for b in beams])[:-1]
+    eff = scene["effects"]
+    effects: list[Effect] = [Inertia(), Elasticity()]
+    if eff["filtering"]:
+        effects.append(StressFilter(scene["filtering"]["h"]))
+    if eff["gravity"]:
+        effects.append(Gravity(np.array(scene["gravity"]["g"])))
+
+    Q0 = np.concatenate([b.straight_coordinates(sb["origin"], sb["direction"])
+                         for b, sb in zip(beams, scene["beams"])])
+    Qd0 = np.zeros_like(Q0)
+    cons: list[LinearConstraint] = []
+    constrained_ends = set()
+    for bc in scene["boundary"]:
+        ib, end = bc["beam"], bc["end"]
+        b, sb = beams[ib], scene["beams"][ib]
+        d = np.asarray(sb["direction"], float)
+        d /= np.linalg.norm(d)
+        s_end = b.breakpoints[0] if end == "left" else b.breakpoints[-1]
+        pos = bc["position"] if bc["position"] is not None else np.asarray(sb["origin"]) + s_end * d
+        direction = bc["direction"] if bc["direction"] is not None else d
+        s_fun = None
+        if bc["kind"] == "sleeve":
+            v = bc["speed"]
+            s_fun = (lambda t, s0=s_end, v=v: s0 + v * t, lambda t, v=v: v, lambda t: 0.0)
+            Qd0[offsets[ib] + b.s_coord(0 if end == "left" else len(b.elements))] = v
+        cons.append(boundary_condition(offsets, beams, ib, end, bc["kind"], pos, direction, s_fun,
+                                       fix_torsion=eff["torsion"]))
+        constrained_ends.add((ib, end))
+    # every beam end that is not a sleeve is a material point (s = 0 or L), Eq. 50
+    for ib, b in enumerate(beams):
+        for end in ("left", "right"):
+            if (ib, end) not in constrained_ends:
+                cons.append(boundary_condition(offsets, beams, ib, end, "free"))
+    if not eff["torsion"]:
+        cons.append(_no_torsion(offsets, beams))
+
+    loads = []
+    for pl in scene["point_loads"]:
+        f = np.asarray(pl["force"], float)
+        t0 = pl["start"]
+        loads.append(PointLoad(pl["beam"], lambda t, s=pl["s"], v=pl["speed"]: s + v * t,
+                               lambda t, f=f, t0=t0: f if t >= t0 else 0.0 * f))
+    model = Model(beams, effects, loads, cons)
+    model.scene = scene
+    return model, Q0, Qd0
+
+
+def _no_torsion(offsets, beams) -> LinearConstraint:
+    """effects.torsion = false: all torsion angles and their derivatives are held at zero,
+    so the torsional coordinates leave the integrated state."""
+    rows = []
+    for ib, b in enumerate(beams):
+        for e, el in enumerate(b.elements):
+            for k in range(el.n):
+                for what in ("g", "gp"):
+                    rows.append(int(offsets[ib] + b.index_map[e][el.index(what, k)]))
+    rows = sorted(set(rows))
+    z = np.zeros(len(rows))
+    return LinearConstraint("no_torsion", [{i: 1.0} for i in rows],
+                            lambda t: z, lambda t: z, lambda t: z)

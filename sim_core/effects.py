@@ -1,0 +1,149 @@
+"""Effects: the generalized-force and mass contributions a scene switches on.
+
+Each effect is a small object that adds its share to the element mass matrix and force vector
+from the shared per-element kinematics.  The model computes only the kinematic quantities the
+listed effects declare in ``needs`` and calls exactly those effects: an effect that is off is
+not in the list, so nothing of it is computed (PyElastica-style assembly).
+
+Sign convention: the element equations are  M q_ddot = F,  with F = external - internal -
+convective forces.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable, ClassVar
+
+import numpy as np
+
+from .beam.moving_node_beam import PointKinematics, SplineElement
+
+
+@dataclass
+class ElementContext:
+    """Everything an effect may read for one element at one instant."""
+
+    t: float
+    el: SplineElement
+    qe: np.ndarray
+    qde: np.ndarray
+    kin: PointKinematics
+    wl: np.ndarray                 # quadrature weight * sub-element length, m
+    conv: dict | None = None       # complex-step convective terms (see Model)
+
+
+def _gram(J: np.ndarray, scale: np.ndarray) -> np.ndarray:
+    """sum_g J_g^T diag(scale_g^2) J_g for J of shape (G, k, n) and scale (G, k) (one BLAS call)."""
+    A = (J * scale[:, :, None]).reshape(-1, J.shape[2])
+    return A.T @ A
+
+
+class Effect:
+    """Base class: ``needs`` lists kinematic quantities this effect reads."""
+
+    needs: ClassVar[frozenset] = frozenset()
+    name: ClassVar[str] = "effect"
+
+    def element_terms(self, ctx: ElementContext, M: np.ndarray | None, F: np.ndarray) -> None:
+        raise NotImplementedError
+
+
+class Inertia(Effect):
+    """Translational and rotary inertia with material accelerations (Eq. 34, 2nd and 3rd terms).
+
+    M += int rhoA J_r^T J_r + J_w^T J J_w ds;
+    F -= int rhoA J_r^T (J_r)^. q_dot + J_w^T (J (J_w)^. q_dot + omega x J omega) ds.
+    """
+
+    needs = frozenset({"convective"})
+    name = "inertia"
+
+    def element_terms(self, ctx, M, F):
+        sec = ctx.el.section
+        kin, wl = ctx.kin, ctx.wl
+        Jd = sec.J
+        if M is not None:
+            M += _gram(kin.J_r, np.sqrt(wl * sec.rhoA)[:, None])
+            M += _gram(kin.J_w, np.sqrt(wl[:, None] * Jd))
+        if ctx.conv is not None:
+            omega = np.einsum("gin,n->gi", kin.J_w, ctx.qde)
+            rot = Jd * ctx.conv["w_dot"] + np.cross(omega, Jd * omega)
+            F -= np.einsum("g,gin,gi->n", wl * sec.rhoA, kin.J_r, ctx.conv["a"])
+            F -= np.einsum("g,gin,gi->n", wl, kin.J_w, rot)
+
+
+class Elasticity(Effect):
+    """Internal forces as the gradient of the strain energy (Eq. 34 first term, Eq. 36).
+
+    F -= sum_g w [ l B_xi^T D eps + W dl/dq ];  see moving_node_beam for why the energy form.
+    """
+
+    needs = frozenset({"strains"})
+    name = "elasticity"
+
+    def element_terms(self, ctx, M, F):
+        el, kin, wl = ctx.el, ctx.kin, ctx.wl
+        D = el.section.D
+        sigma = kin.sec.eps * D
+        F -= np.einsum("g,gin,gi->n", wl, kin.B_xi, sigma)
+        W = 0.5 * np.einsum("gi,gi->g", sigma, kin.sec.eps)
+        total = np.dot(el.q_w, W)            # dU/dl at fixed xi
+        inv = 1.0 / (el.n - 1)
+        F[el.i_s1] += total * inv     # dl/ds_1 = -1/(n-1), with the minus of F -= ...
+        F[el.i_sn] -= total * inv
+
+
+class StressFilter(Effect):
+    """High-frequency filtering of the internal stress (second seed, Eq. 53).
+
+    sigma_bar = sigma + (h/2) sigma_dot + (h^2/6) sigma_ddot with material rates:
+    adds (h^2/6) int B_s^T D B_s ds to the mass matrix and the damping-like forces
+    (h/2) int B_s^T D eps_dot ds + (h^2/6) int B_s^T D (B_s)^. q_dot ds.
+    """
+
+    needs = frozenset({"strains", "material_strain", "convective"})
+    name = "filtering"
+
+    def __init__(self, h: float):
+        if not (h > 0 and np.isfinite(h)):
+            raise ValueError(f"filtering.h = {h!r}: must be > 0 (0 switches the effect off)")
+        self.h = float(h)
+
+    def element_terms(self, ctx, M, F):
+        D = ctx.el.section.D
+        B = ctx.kin.B_s
+        h = self.h
+        if M is not None:
+            M += (h * h / 6.0) * _gram(B, np.sqrt(ctx.wl[:, None] * D))
+        eps_dot = np.einsum("gin,n->gi", B, ctx.qde)
+        extra = D * (0.5 * h * eps_dot + (h * h / 6.0) * ctx.conv["eps_ddot"])
+        F -= np.einsum("g,gin,gi->n", ctx.wl, B, extra)
+
+
+class Gravity(Effect):
+    """Distributed weight: F += int rhoA J_r^T g ds."""
+
+    name = "gravity"
+
+    def __init__(self, g: np.ndarray):
+        self.g = np.asarray(g, dtype=float)
+
+    def element_terms(self, ctx, M, F):
+        F += np.einsum("g,gin,i->n", ctx.wl * ctx.el.section.rhoA, ctx.kin.J_r, self.g)
+
+
+@dataclass
+class PointLoad:
+    """A force (and optional moment, section-frame components) at a material point.
+
+    ``s_of_t`` gives the material coordinate of the loaded point (constant for a material
+    point, a function of time for a moving load, e.g. Fryba's force at s = c t).  Force and
+    moment are functions of time returning (3,) arrays (global force, section-frame moment).
+    Virtual power: delta(dr/dt|_s) . f + delta omega . m  (Section 7).
+    """
+
+    beam: int
+    s_of_t: Callable[[float], float]
+    force: Callable[[float], np.ndarray]
+    moment: Callable[[float], np.ndarray] | None = None
+    name: ClassVar[str] = "point_load"

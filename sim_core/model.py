@@ -1,0 +1,338 @@
+"""Assembled model: beams + effects + boundary conditions -> M(q) q_ddot = F(t, q, q_dot).
+
+Boundary conditions of the single-beam problems (clamped end, pinned end, roller, fixed material
+end, end drawn through a rigid sleeve) are *linear* in the coordinates Q with prescribed right-
+hand sides, A Q = b(t).  They are eliminated exactly: Q = Q_p(t) + P z with P an orthonormal
+basis of null(A) and Q_p = A^+ b(t), so the integrated state is (z, z_dot) and there is no
+constraint drift.  Constraint reactions are recovered as A^T lambda = M Q_ddot - F.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, Sequence
+
+import numpy as np
+import scipy.linalg as sla
+
+from .beam.moving_node_beam import Beam
+from .effects import Effect, ElementContext, PointLoad
+
+_CSTEP = 1e-20   # complex-step size (no subtractive cancellation, any tiny value works)
+
+Scalar = Callable[[float], float]
+
+
+@dataclass
+class LinearConstraint:
+    """Rows a . Q = b(t) with the first two time derivatives of b (m, m/s, m/s^2 ...)."""
+
+    name: str
+    rows: np.ndarray | list                # (m, N) dense, or sparse [{index: coeff}] per row
+    value: Callable[[float], np.ndarray]   # b(t)   (m,)
+    rate: Callable[[float], np.ndarray]    # b'(t)
+    accel: Callable[[float], np.ndarray]   # b''(t)
+
+
+def _const(v):
+    v = np.atleast_1d(np.asarray(v, dtype=float))
+    z = np.zeros_like(v)
+    return (lambda t: v), (lambda t: z), (lambda t: z)
+
+
+@dataclass
+class Model:
+    """A set of beams with the effects and boundary conditions of a scene."""
+
+    beams: list[Beam]
+    effects: list[Effect]
+    point_loads: list[PointLoad] = field(default_factory=list)
+    constraints: list[LinearConstraint] = field(default_factory=list)
+
+    def __post_init__(self):
+        self.offsets = np.cumsum([0] + [b.n_coords for b in self.beams])[:-1]
+        self.n_coords = int(sum(b.n_coords for b in self.beams))
+        self.needs = frozenset().union(*(e.needs for e in self.effects)) if self.effects else frozenset()
+        self._reduce()
+
+    # -- constraint elimination ----------------------------------------------------------
+    def _reduce(self) -> None:
+        N = self.n_coords
+        for c in self.constraints:
+            if isinstance(c.rows, list):      # sparse {index: coefficient} rows
+                c.rows = _rows(N, c.rows)
+        if self.constraints:
+            A = np.vstack([c.rows for c in self.constraints])
+        else:
+            A = np.zeros((0, N))
+        self.A = A
+        if A.shape[0]:
+            u, sv, vt = np.linalg.svd(A)
+            rank = int(np.sum(sv > 1e-12 * sv[0]))
+            if rank < A.shape[0]:
+                raise ValueError("boundary conditions are redundant (rank-deficient constraint rows)")
+            self.P = vt[rank:].T
+            self.A_pinv = np.linalg.pinv(A)
+        else:
+            self.P = np.eye(N)
+            self.A_pinv = np.zeros((N, 0))
+        self.n_dof = self.P.shape[1]
+
+    def _b(self, t: float, which: int) -> np.ndarray:
+        if not self.constraints:
+            return np.zeros(0)
+        return np.concatenate([(c.value, c.rate, c.accel)[which](t) for c in self.constraints])
+
+    def full_state(self, t: float, z: np.ndarray, zd: np.ndarray):
+        """Q, Q_dot from the reduced state."""
+        Q = self.A_pinv @ self._b(t, 0) + self.P @ z
+        Qd = self.A_pinv @ self._b(t, 1) + self.P @ zd
+        return Q, Qd
+
+    def reduced_state(self, t: float, Q: np.ndarray, Qd: np.ndarray):
+        """Project a full state onto the constraint manifold's coordinates (z, z_dot)."""
+        z = self.P.T @ (Q - self.A_pinv @ self._b(t, 0))
+        zd = self.P.T @ (Qd - self.A_pinv @ self._b(t, 1))
+        return z, zd
+
+    # -- assembly --------------------------------------------------------------------------
+    def element_contexts(self, t: float, Q: np.ndarray, Qd: np.ndarray):
+        """Yield (global indices, ElementContext) for every element; kinematics computed once."""
+        strains = "strains" in self.needs
+        mat = "material_strain" in self.needs
+        conv = "convective" in self.needs
+        for b, off in zip(self.beams, self.offsets):
+            for el, imap in zip(b.elements, b.index_map):
+                idx = off + imap
+                qe, qde = Q[idx], Qd[idx]
+                kin = el.evaluate(qe, strains=strains, material_strain=mat)
+                ctx = ElementContext(t, el, qe, qde, kin, el.q_w * kin.ell)
+                if conv:
+                    kc = el.evaluate(qe + 1j * _CSTEP * qde, s=kin.s, sub=kin.sub,
+                                     strains=mat, material_strain=mat)
+                    c = {"a": np.einsum("gin,n->gi", kc.J_r, qde).imag / _CSTEP,
+                         "w_dot": np.einsum("gin,n->gi", kc.J_w, qde).imag / _CSTEP}
+                    if mat:
+                        c["eps_ddot"] = np.einsum("gin,n->gi", kc.B_s, qde).imag / _CSTEP
+                    ctx.conv = c
+                yield idx, ctx
+
+    def mass_force(self, t: float, Q: np.ndarray, Qd: np.ndarray, mass: bool = True):
+        """Full-coordinate mass matrix (or None) and force vector: M Q_ddot = F."""
+        N = self.n_coords
+        M = np.zeros((N, N)) if mass else None
+        F = np.zeros(N)
+        for idx, ctx in self.element_contexts(t, Q, Qd):
+            ne = len(idx)
+            Me = np.zeros((ne, ne)) if mass else None
+            Fe = np.zeros(ne)
+            for eff in self.effects:
+                eff.element_terms(ctx, Me, Fe)
+            if mass:
+                M[np.ix_(idx, idx)] += Me
+            np.add.at(F, idx, Fe)
+        for pl in self.point_loads:
+            self._add_point_load(pl, t, Q, F)
+        return M, F
+
+    def _add_point_load(self, pl: PointLoad, t: float, Q: np.ndarray, F: np.ndarray) -> None:
+        beam = self.beams[pl.beam]
+        off = self.offsets[pl.beam]
+        s = float(pl.s_of_t(t))
+        e = self._element_at(pl.beam, Q, s)
+        idx = off + beam.index_map[e]
+        kin = beam.elements[e].evaluate(Q[idx], s=np.array([s]), strains=False)
+        F[idx] += kin.J_r[0].T @ np.asarray(pl.force(t), float)
+        if pl.moment is not None:
+            F[idx] += kin.J_w[0].T @ np.asarray(pl.moment(t), float)
+
+    def _element_at(self, ibeam: int, Q: np.ndarray, s: float) -> int:
+        beam = self.beams[ibeam]
+        off = self.offsets[ibeam]
+        for e in range(len(beam.elements) - 1):
+            if s < Q[off + beam.s_coord(e + 1)]:
+                return e
+        return len(beam.elements) - 1
+
+    # -- reduced dynamics ------------------------------------------------------------------
+    def reduced_mass_force(self, t: float, z: np.ndarray, zd: np.ndarray):
+        Q, Qd = self.full_state(t, z, zd)
+        M, F = self.mass_force(t, Q, Qd)
+        Qdd_p = self.A_pinv @ self._b(t, 2)
+        Mr = self.P.T @ M @ self.P
+        Fr = self.P.T @ (F - M @ Qdd_p)
+        return Mr, Fr
+
+    @property
+    def n(self) -> int:
+        """Number of independent coordinates (integrators.SecondOrderSystem protocol)."""
+        return self.n_dof
+
+    def mass_and_force(self, t: float, q: np.ndarray, v: np.ndarray):
+        """(M, f) of the reduced system M z_ddot = f (integrators.SecondOrderSystem)."""
+        return self.reduced_mass_force(t, q, v)
+
+    def accelerations(self, t: float, z: np.ndarray, zd: np.ndarray) -> np.ndarray:
+        Mr, Fr = self.reduced_mass_force(t, z, zd)
+        return sla.solve(Mr, Fr, assume_a="pos")
+
+    def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
+        """First-order right-hand side for y = (z, z_dot)."""
+        n = self.n_dof
+        z, zd = y[:n], y[n:]
+        return np.concatenate([zd, self.accelerations(t, z, zd)])
+
+    def reactions(self, t: float, z: np.ndarray, zd: np.ndarray) -> np.ndarray:
+        """Constraint multipliers lambda (one per constraint row): A^T lambda = M Q_ddot - F."""
+        Q, Qd = self.full_state(t, z, zd)
+        M, F = self.mass_force(t, Q, Qd)
+        Qdd = self.A_pinv @ self._b(t, 2) + self.P @ self.accelerations(t, z, zd)
+        return self.A_pinv.T @ (M @ Qdd - F)
+
+    # -- energies ----------------------------------------------------------------------------
+    def energies(self, t: float, Q: np.ndarray, Qd: np.ndarray, gravity=None) -> dict:
+        """Kinetic T (material velocities), strain U and gravity potential V, J."""
+        T = U = V = 0.0
+        g = np.zeros(3) if gravity is None else np.asarray(gravity, float)
+        for b, off in zip(self.beams, self.offsets):
+            for el, imap in zip(b.elements, b.index_map):
+                qe, qde = Q[off + imap], Qd[off + imap]
+                kin = el.evaluate(qe, strains=True)
+                wl = el.q_w * kin.ell
+                v = np.einsum("gin,n->gi", kin.J_r, qde)
+                w = np.einsum("gin,n->gi", kin.J_w, qde)
+                sec = el.section
+                T += 0.5 * np.dot(wl, sec.rhoA * np.sum(v * v, axis=1) + w * w @ sec.J)
+                U += np.dot(wl, el.strain_energy_density(kin))
+                V -= np.dot(wl * sec.rhoA, kin.r @ g)
+        return {"T": float(T), "U": float(U), "V": float(V)}
+
+    # -- points ------------------------------------------------------------------------------
+    def point_motion(self, ibeam: int, s: float, t: float, z: np.ndarray, zd: np.ndarray,
+                     zdd: np.ndarray | None = None):
+        """Position, material velocity and (if zdd given) material acceleration of material
+        point s of beam ``ibeam`` (global frame; m, m/s, m/s^2)."""
+        Q, Qd = self.full_state(t, z, zd)
+        r, kin, idx = self.point(ibeam, s, Q)
+        v = kin.J_r[0] @ Qd[idx]
+        if zdd is None:
+            return r, v, None
+        Qdd = self.A_pinv @ self._b(t, 2) + self.P @ zdd
+        el = self.beams[ibeam].elements[0]
+        e = self._element_at(ibeam, Q, s)
+        el = self.beams[ibeam].elements[e]
+        kc = el.evaluate(Q[idx] + 1j * _CSTEP * Qd[idx], s=kin.s, sub=kin.sub, strains=False)
+        a = kin.J_r[0] @ Qdd[idx] + (kc.J_r[0] @ Qd[idx]).imag / _CSTEP
+        return r, v, a
+
+    def point(self, ibeam: int, s: float, Q: np.ndarray):
+        """Position (3,) of material point s of beam ``ibeam`` and its element kinematics."""
+        beam = self.beams[ibeam]
+        off = self.offsets[ibeam]
+        e = self._element_at(ibeam, Q, s)
+        idx = off + beam.index_map[e]
+        kin = beam.elements[e].evaluate(Q[idx], s=np.array([s]), strains=True)
+        return kin.r[0], kin, idx
+
+
+# -- boundary conditions ---------------------------------------------------------------------
+
+def _rows(N: int, entries: Sequence[dict[int, float]]) -> np.ndarray:
+    A = np.zeros((len(entries), N))
+    for i, ent in enumerate(entries):
+        for j, v in ent.items():
+            A[i, j] = v
+    return A
+
+
+def _perp(d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    d = d / np.linalg.norm(d)
+    a = np.eye(3)[np.argmin(np.abs(d))]
+    n1 = np.cross(d, a)
+    n1 /= np.linalg.norm(n1)
+    return n1, np.cross(d, n1)
+
+
+def end_index(beam: Beam, end: str):
+    """(element, node, breakpoint) of the 'left' (s = 0) or 'right' (s = L) end."""
+    if end == "left":
+        return 0, 0, 0
+    if end == "right":
+        return len(beam.elements) - 1, beam.n_nodes - 1, len(beam.elements)
+    raise ValueError(f"end = {end!r}: allowed 'left' or 'right'")
+
+
+def boundary_condition(model_offsets, beams: list[Beam], ibeam: int, end: str, kind: str,
+                       position=None, direction=None, s_of_t=None,
+                       fix_torsion: bool = True) -> LinearConstraint:
+    """Linear boundary condition at a beam end.
+
+    kind:
+      'clamped'  r = position, r' parallel to direction, gamma = 0, material end fixed;
+      'pinned'   r = position, gamma = 0 (no torsional rigid mode), material end fixed;
+      'roller'   r components normal to ``direction`` fixed, gamma = 0, material end fixed;
+      'free'     only the material end is fixed (s = 0 or L);
+      'sleeve'   the end node is the spatial point at the exit of a rigid sleeve: r = position,
+                 r' parallel to direction, gamma = 0, and its material coordinate follows the
+                 prescribed s_of_t = (s(t), s'(t), s''(t)) (material flows through the point).
+    fix_torsion=False omits the gamma row (when torsion is switched off globally).
+    """
+    beam = beams[ibeam]
+    off = int(model_offsets[ibeam])
+    e, node, bp = end_index(beam, end)
+    el = beam.elements[e]
+
+    def gi(what, nd=0, comp=0):
+        return off + int(beam.index_map[e][el.index(what, nd, comp)])
+
+    rp_name = "rp1" if node == 0 else "rpn"
+    entries: list[dict[int, float]] = []
+    vals: list[float] = []
+    pos = None if position is None else np.asarray(position, float)
+    d = None if direction is None else np.asarray(direction, float)
+    if kind in ("clamped", "pinned", "sleeve"):
+        for c in range(3):
+            entries.append({gi("r", node, c): 1.0})
+            vals.append(pos[c])
+    if kind == "roller":
+        for n_ in _perp(d):
+            entries.append({gi("r", node, c): n_[c] for c in range(3)})
+            vals.append(float(n_ @ pos))
+    if kind in ("clamped", "sleeve"):
+        for n_ in _perp(d):
+            entries.append({gi(rp_name, 0, c): n_[c] for c in range(3)})
+            vals.append(0.0)
+    if fix_torsion and kind in ("clamped", "pinned", "roller", "sleeve"):
+        entries.append({gi("g", node): 1.0})
+        vals.append(0.0)
+    s_idx = off + beam.s_coord(bp)
+    entries.append({s_idx: 1.0})
+    n_geom = len(vals)
+    if kind == "sleeve":
+        if s_of_t is None:
+            raise ValueError("sleeve boundary condition needs s_of_t = (s, s_dot, s_ddot)")
+        fs, fv, fa = s_of_t
+    else:
+        s0 = 0.0 if end == "left" else beam.length
+        fs, fv, fa = (lambda t: s0), (lambda t: 0.0), (lambda t: 0.0)
+    geo = np.asarray(vals, float)
+    zero = np.zeros(n_geom)
+
+    def value(t):
+        return np.append(geo, fs(t))
+
+    def rate(t):
+        return np.append(zero, fv(t))
+
+    def accel(t):
+        return np.append(zero, fa(t))
+
+    return LinearConstraint(f"{kind}:{beam.name}:{end}", entries, value, rate, accel)
+
+
+def fix_material_coordinate(model_offsets, beams: list[Beam], ibeam: int, breakpoint: int,
+                            value: float) -> LinearConstraint:
+    """A breakpoint that is a material point (e.g. the luffing point s_3,1 = L_h, Eq. 50)."""
+    idx = int(model_offsets[ibeam]) + beams[ibeam].s_coord(breakpoint)
+    v, r, a = _const([value])
+    return LinearConstraint(f"material:{beams[ibeam].name}:{breakpoint}", [{idx: 1.0}], v, r, a)

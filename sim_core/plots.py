@@ -1,0 +1,57 @@
+"""Figures of a result (matplotlib, Agg backend, PNG written atomically)."""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+
+import numpy as np
+
+from .result import Result, atomic_write_bytes
+
+
+def _save(fig, path: Path) -> Path:
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110)
+    atomic_write_bytes(path, buf.getvalue())
+    return path
+
+
+def plot_result(result: Result, out: str | Path) -> list[Path]:
+    """Tip position/velocity/acceleration components and energies vs time."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out = Path(out)
+    t = result.t
+    paths = []
+    names = [n for n in ("tip_position", "tip_velocity", "tip_acceleration") if n in result]
+    if names:
+        fig, axes = plt.subplots(len(names), 1, figsize=(8, 2.6 * len(names)), sharex=True)
+        axes = np.atleast_1d(axes)
+        units = {"tip_position": "m", "tip_velocity": "m/s", "tip_acceleration": "m/s²"}
+        for ax, n in zip(axes, names):
+            for c, lab in enumerate("XYZ"):
+                ax.plot(t, result[n][:, c], label=lab)
+            ax.set_ylabel(f"{n.replace('_', ' ')} [{units[n]}]")
+            ax.grid(alpha=0.3)
+            ax.legend(loc="best", fontsize=8)
+        axes[-1].set_xlabel("t [s]")
+        fig.suptitle(result.scene.get("name", ""))
+        fig.tight_layout()
+        paths.append(_save(fig, out / "tip.png"))
+        plt.close(fig)
+    if "energy_kinetic" in result:
+        fig, ax = plt.subplots(figsize=(8, 3))
+        for n in ("energy_kinetic", "energy_strain", "energy_gravity"):
+            if n in result:
+                ax.plot(t, result[n], label=n.split("_")[1])
+        ax.set_xlabel("t [s]")
+        ax.set_ylabel("energy [J]")
+        ax.grid(alpha=0.3)
+        ax.legend()
+        fig.tight_layout()
+        paths.append(_save(fig, out / "energy.png"))
+        plt.close(fig)
+    return paths

@@ -1,0 +1,1 @@
+"""Closed-form reference solutions for tests and benchmarks (see ``closed_form``)."""

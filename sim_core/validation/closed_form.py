@@ -1,0 +1,301 @@
+"""Closed-form reference solutions (SI units) for the validation cases of design/SCENARIOS.md.
+
+Sources
+-------
+* C1 cantilever statics, C2 cantilever/bar frequencies: Euler-Bernoulli beam theory
+  (e.g. Timoshenko & Gere; Blevins, "Formulas for natural frequency and mode shape").
+* C3 moving force on a simply supported beam: Fryba, "Vibration of Solids and Structures under
+  Moving Loads" (1972), Ch. 1, series exactly as transcribed in SCENARIOS C3.
+* C4 rod through a frictionless sleeve: Bigoni, Dal Corso, Bosi, Misseroni, "Eshelby-like forces
+  acting on elastic structures", J. Mech. Phys. Solids 2015 (configurational force M^2/(2EI)).
+* A9 / C6 rigid-limit tip kinematics: Zhao-Qi-Wang 2024, Section 9.1, Eqs. 74-76.
+* A2 luffing geometry and C7 static forces: Zhao-Qi-Wang 2024, Section 9 (Fig. 13a, the L_h
+  equation and rotation R) with the proposed-default signs of SCENARIOS A2.
+
+Frames (SCENARIOS A1/A2): global X forward, Z up, Y = Z x X.  Boom-1 left-section components are
+(axial e_s, lateral e_t, e_b); at theta = 0 they coincide with (X, Y, Z).  PD rotation
+R(theta) = [[cos, 0, -sin], [0, 1, 0], [sin, 0, cos]] maps them to global; theta > 0 lifts the tip.
+
+"Top centre of boom 3" (A8/A9): the paper calls the right-end section the *top* section (B1, B3
+are given "relative to the top cross-sections").  Its *centre* is the section-frame origin, i.e.
+the centre of the lower half circle = the beam reference line (A1), at material coordinate
+s = boom_length of boom 3, whose left section lies 2 L_s along boom 1's axis (A3).  This
+reproduces the quoted start points (7.404, 13.024) m (L_s = 2 m) and (13.404, 23.417) m (8 m).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Sequence
+
+import numpy as np
+from scipy.optimize import brentq
+
+from ..drive_profiles import ArrayLike, DriveProfile
+from ..errors import SceneError
+
+# --- A2 mounting points (m): global r1 (D1), r2 (D2); boom-1 left-section rbar1 (D1), rbar3 (D3).
+R1_DEFAULT = (-0.556, 0.0, 0.350)
+R2_DEFAULT = (0.100, 0.0, 0.050)
+RBAR1_DEFAULT = (-0.956, 0.0, 0.556)
+RBAR3_DEFAULT = (7.250, 0.0, -0.556)
+# --- A1 Table 2: mass per length (kg/m) and mass-centre offset z_c along e_b (m), booms 1..3.
+M_PER_LENGTH_DEFAULT = (318.86, 304.07, 289.27)
+Z_C_DEFAULT = (0.045, 0.044, 0.043)
+
+
+def _pos(name: str, value: float) -> float:
+    """Return float(value); raise SceneError unless finite and > 0."""
+    v = float(value)
+    if not (math.isfinite(v) and v > 0):
+        raise SceneError(f"{name} = {value!r} is invalid; allowed range: > 0 (finite)")
+    return v
+
+
+# ----------------------------------------------------------------------------- C1 statics
+@dataclass(frozen=True)
+class TipResponse:
+    """Cantilever tip deflection (m, along the load) and tip slope (rad)."""
+
+    deflection: float
+    slope: float
+
+
+def cantilever_tip_load(P: float, L: float, EI: float) -> TipResponse:
+    """Cantilever, tip force P (N), length L (m), EI (N m^2): w = PL^3/(3EI), w' = PL^2/(2EI)."""
+    L, EI = _pos("L", L), _pos("EI", EI)
+    return TipResponse(P * L**3 / (3 * EI), P * L**2 / (2 * EI))
+
+
+def cantilever_uniform_load(q: float, L: float, EI: float) -> TipResponse:
+    """Cantilever under uniform load q (N/m, e.g. m' g): w = qL^4/(8EI), w' = qL^3/(6EI)."""
+    L, EI = _pos("L", L), _pos("EI", EI)
+    return TipResponse(q * L**4 / (8 * EI), q * L**3 / (6 * EI))
+
+
+# ----------------------------------------------------------------------------- C2 frequencies
+def cantilever_beta_L(n_modes: int = 3) -> np.ndarray:
+    """Roots beta_n L of the clamped-free frequency equation 1 + cos x cosh x = 0 (brentq).
+
+    Solved as cos x + 1/cosh x = 0 (same roots, no overflow); root n lies in ((n-1)pi, n pi).
+    Returns (n_modes,) array: 1.8751, 4.6941, 7.8548, ...
+    """
+    if int(n_modes) < 1:
+        raise SceneError(f"n_modes = {n_modes!r} is invalid; allowed range: >= 1")
+    f = lambda x: math.cos(x) + 1.0 / math.cosh(x)  # noqa: E731
+    lo = 1e-9
+    return np.array([brentq(f, max((n - 1) * math.pi, lo), n * math.pi, xtol=1e-14)
+                     for n in range(1, int(n_modes) + 1)])
+
+
+def cantilever_bending_omegas(EI: float, m: float, L: float, n_modes: int = 3) -> np.ndarray:
+    """Clamped-free bending circular frequencies omega_n = (beta_n L)^2 sqrt(EI/(m L^4)), rad/s.
+
+    EI (N m^2), m mass per length (kg/m), L (m).
+    """
+    EI, m, L = _pos("EI", EI), _pos("m", m), _pos("L", L)
+    return cantilever_beta_L(n_modes) ** 2 * math.sqrt(EI / (m * L**4))
+
+
+def fixed_free_axial_f1(EA: float, m: float, L: float) -> float:
+    """First axial frequency of a fixed-free bar f1 = sqrt(EA/m)/(4L), Hz (EA N, m kg/m, L m)."""
+    return math.sqrt(_pos("EA", EA) / _pos("m", m)) / (4 * _pos("L", L))
+
+
+def fixed_free_torsion_f1(GJ: float, J_s: float, L: float) -> float:
+    """First torsional frequency f1 = sqrt(GJ/J_s)/(4L), Hz (GJ N m^2, J_s kg m, L m)."""
+    return math.sqrt(_pos("GJ", GJ) / _pos("J_s", J_s)) / (4 * _pos("L", L))
+
+
+# ----------------------------------------------------------------------------- C3 Fryba
+def fryba_deflection(x: ArrayLike, t: ArrayLike, P: float, c: float, L: float, EI: float,
+                     m: float, n_terms: int = 50) -> np.ndarray:
+    """Deflection w(x, t) (m, along P) of a simply supported beam under a force P (N) moving
+    at speed c (m/s) from x = 0 at t = 0, zero initial state, valid for 0 <= t <= L/c
+    (SCENARIOS C3; the sum runs over j = 1..n_terms):
+
+        w = w0 sum_j [sin(j w t) - (alpha/j) sin(w_j t)] sin(j pi x/L) / (j^2 (j^2 - alpha^2)),
+        w0 = 2 P L^3/(pi^4 EI),  w = pi c/L,  w_j = j^2 (pi/L)^2 sqrt(EI/m),  alpha = w/w_1.
+
+    x (m) and t (s) broadcast against each other; EI (N m^2), m (kg/m).  Raises SceneError if
+    alpha is an integer <= n_terms (resonant term) or t leaves [0, L/c].
+    """
+    c, L, EI, m = _pos("c", c), _pos("L", L), _pos("EI", EI), _pos("m", m)
+    n = int(n_terms)
+    if n < 1:
+        raise SceneError(f"n_terms = {n_terms!r} is invalid; allowed range: >= 1")
+    t = np.asarray(t, dtype=float)
+    x = np.asarray(x, dtype=float)
+    if np.any(t < 0) or np.any(t > (L / c) * (1 + 1e-12)):
+        raise SceneError(f"t = [{t.min()!r}, {t.max()!r}] is invalid; allowed range: "
+                         f"0 <= t <= L/c = {L / c!r} s (force on the beam)")
+    w0 = 2 * P * L**3 / (math.pi**4 * EI)
+    om = math.pi * c / L
+    om1 = (math.pi / L) ** 2 * math.sqrt(EI / m)
+    alpha = om / om1
+    j = np.arange(1, n + 1, dtype=float)
+    if np.any(np.abs(j - alpha) < 1e-9):
+        raise SceneError(f"alpha = {alpha!r} is invalid; allowed range: not an integer <= {n}")
+    tt, xx = np.broadcast_arrays(t, x)
+    tt, xx = tt[..., None], xx[..., None]
+    om_j = j**2 * om1
+    terms = ((np.sin(j * om * tt) - (alpha / j) * np.sin(om_j * tt)) * np.sin(j * math.pi * xx / L)
+             / (j**2 * (j**2 - alpha**2)))
+    return w0 * terms.sum(axis=-1)
+
+
+# ----------------------------------------------------------------------------- C4 sleeve
+@dataclass(frozen=True)
+class SleeveReference:
+    """Bigoni et al. 2015: tip deflection (m), clamp moment M = P l (N m), and configurational
+    (Eshelby-like) force M^2/(2EI) (N) pushing the rod out of the sleeve."""
+
+    tip_deflection: float
+    moment: float
+    configurational_force: float
+
+
+def bigoni_sleeve(P: float, ell: float, EI: float) -> SleeveReference:
+    """Rod of free length ell (m) out of a frictionless sleeve, tip load P (N), EI (N m^2)."""
+    ell, EI = _pos("ell", ell), _pos("EI", EI)
+    M = P * ell
+    return SleeveReference(P * ell**3 / (3 * EI), M, M**2 / (2 * EI))
+
+
+# ----------------------------------------------------------------------------- A2 geometry
+def luffing_rotation(theta: float) -> np.ndarray:
+    """PD rotation R(theta) (SCENARIOS A2): boom-1 section components -> global, theta in rad."""
+    ct, st = math.cos(theta), math.sin(theta)
+    return np.array([[ct, 0.0, -st], [0.0, 1.0, 0.0], [st, 0.0, ct]])
+
+
+@dataclass(frozen=True)
+class LuffingGeometry:
+    """Initial (rigid) boom-1 geometry at luffing angle theta; global positions in m.
+
+    rotation: R(theta); origin: boom-1 left-section origin O = r1 - R rbar1; d1, d2, d3: pivot,
+    cylinder base, cylinder head; cylinder_length = |D3 - D2|; lever = distance from D1 to the
+    line D2-D3; e_s = boom axis direction R e_x.
+    """
+
+    theta: float
+    rotation: np.ndarray
+    origin: np.ndarray
+    d1: np.ndarray
+    d2: np.ndarray
+    d3: np.ndarray
+    cylinder_length: float
+    lever: float
+    e_s: np.ndarray
+
+
+def luffing_geometry(theta: float, r1: Sequence[float] = R1_DEFAULT,
+                     r2: Sequence[float] = R2_DEFAULT, rbar1: Sequence[float] = RBAR1_DEFAULT,
+                     rbar3: Sequence[float] = RBAR3_DEFAULT) -> LuffingGeometry:
+    """Geometry of Zhao-Qi-Wang 2024 Sec. 9 / SCENARIOS A2: L_cyl = |r1 - r2 + R(rbar3 - rbar1)|.
+
+    theta in rad; r1, r2 global (m); rbar1, rbar3 in boom-1 left-section components (m).
+    At theta = 60 deg: L_cyl = 8.147 m, O = (0.4035, 0, 0.8999) m, lever = 0.714 m.
+    """
+    R = luffing_rotation(theta)
+    r1a, r2a = np.asarray(r1, float), np.asarray(r2, float)
+    rb1, rb3 = np.asarray(rbar1, float), np.asarray(rbar3, float)
+    origin = r1a - R @ rb1                    # D1 is fixed both globally and in the boom
+    d3 = origin + R @ rb3
+    cyl = d3 - r2a                            # = r1 - r2 + R (rbar3 - rbar1)
+    L_cyl = float(np.linalg.norm(cyl))
+    lever = float(np.linalg.norm(np.cross(r1a - r2a, cyl / L_cyl)))
+    return LuffingGeometry(theta, R, origin, r1a, r2a, d3, L_cyl, lever, R[:, 0].copy())
+
+
+def boom3_top_centre(theta: float, L_s: ArrayLike, boom_length: float = 10.0,
+                     **geometry: Sequence[float]) -> np.ndarray:
+    """Global (X, Z) of the top centre of boom 3 in the rigid state (m), shape (..., 2).
+
+    Reference-line point of boom 3's right-end section: O + (2 L_s + boom_length) e_s (A1-A3).
+    ``geometry`` forwards r1, r2, rbar1, rbar3 to ``luffing_geometry``.
+    """
+    g = luffing_geometry(theta, **geometry)
+    a = 2 * np.asarray(L_s, float)[..., None] + boom_length
+    p = g.origin + a * g.e_s
+    return p[..., [0, 2]]
+
+
+# ----------------------------------------------------------------------------- A9 / C6
+@dataclass(frozen=True)
+class TipKinematics:
+    """Rigid-limit top-centre position (m), velocity (m/s), acceleration (m/s^2), X and Z."""
+
+    x: ArrayLike
+    z: ArrayLike
+    vx: ArrayLike
+    vz: ArrayLike
+    ax: ArrayLike
+    az: ArrayLike
+
+
+def rigid_tip_kinematics(t: ArrayLike, schedule: DriveProfile, theta: float,
+                         r0: Sequence[float]) -> TipKinematics:
+    """Zhao-Qi-Wang 2024 Eqs. 74-76 (SCENARIOS A9): boom 3 moves twice the piston stroke.
+
+    r = r0 + 2 s0(t) (cos th, sin th), v = 2 v(t) (cos th, sin th), a = 2 a(t) (cos th, sin th),
+    with s0(t) = schedule.stroke(t) - schedule.s0 (signed; a retraction schedule with sign = -1
+    gives -s0).  r0 = (X0, Z0) initial top centre (see ``boom3_top_centre``), theta in rad.
+    """
+    ct, st = math.cos(theta), math.sin(theta)
+    ds = np.asarray(schedule.stroke(t), float) - schedule.s0
+    v = np.asarray(schedule.rate(t), float)
+    a = np.asarray(schedule.accel(t), float)
+    return TipKinematics(r0[0] + 2 * ds * ct, r0[1] + 2 * ds * st, 2 * v * ct, 2 * v * st,
+                         2 * a * ct, 2 * a * st)
+
+
+# ----------------------------------------------------------------------------- C7 statics
+@dataclass(frozen=True)
+class StaticLuffingForces:
+    """Rigid static forces at t = 0 (SCENARIOS C7), N and N m.
+
+    luffing_force: cylinder force, > 0 = compression (pushes D3 away from D2);
+    gravity_moment: moment of all weights about D1 (global Y component; > 0 lowers the tip);
+    lever: distance from D1 to the line D2-D3 (m); rope_tension: extraction rope T;
+    telescopic_force: cylinder force between booms 1 and 2 (> 0 pushes boom 2 out);
+    retraction_rope_tension: 0 (slack).
+    """
+
+    luffing_force: float
+    gravity_moment: float
+    lever: float
+    rope_tension: float
+    telescopic_force: float
+    retraction_rope_tension: float = 0.0
+
+
+def static_luffing_forces(theta: float, L_s: float, payload_mass: float, *,
+                          m_per_length: Sequence[float] = M_PER_LENGTH_DEFAULT,
+                          z_c: Sequence[float] = Z_C_DEFAULT, boom_length: float = 10.0,
+                          g: float = 9.81, **geometry: Sequence[float]) -> StaticLuffingForces:
+    """Static luffing-cylinder, rope and telescopic forces of the rigid boom (SCENARIOS C7).
+
+    Moments about D1 (global Y): boom k of mass m_k = boom_length m'_k at axial a_k + boom_length/2
+    (a_k = 0, L_s, 2 L_s, m, along boom 1 from its left section) offset z_c[k] along e_b; payload
+    payload_mass (kg) on the axis at 2 L_s + boom_length; positions O + R (axial, 0, z_c).
+    Balanced by the cylinder force along D2->D3 acting at D3.  Axially (frictionless):
+    T = (m3 + m_p) g sin th, F_tel = m2 g sin th + 2 T.  theta rad, L_s m, g m/s^2.
+    """
+    geo = luffing_geometry(theta, **geometry)
+    R = geo.rotation
+    Lb, g = _pos("boom_length", boom_length), float(g)
+    masses = [Lb * _pos(f"m_per_length[{k}]", mk) for k, mk in enumerate(m_per_length)]
+    if len(masses) != 3 or len(z_c) != 3:
+        raise SceneError(f"m_per_length/z_c lengths = ({len(masses)}, {len(z_c)}) are invalid; "
+                         "allowed: 3 booms each")
+    pts = [geo.origin + R @ np.array([k * L_s + 0.5 * Lb, 0.0, z_c[k]]) for k in range(3)]
+    pts.append(geo.origin + R @ np.array([2 * L_s + Lb, 0.0, 0.0]))
+    weights = [mk * g for mk in masses] + [payload_mass * g]
+    M = sum(float(np.cross(p - geo.d1, np.array([0.0, 0.0, -W]))[1]) for p, W in zip(pts, weights))
+    u = (geo.d3 - geo.d2) / geo.cylinder_length
+    arm = float(np.cross(geo.d3 - geo.d1, u)[1])   # Y moment of a unit compression force at D3
+    F_L = -M / arm
+    T = (masses[2] + payload_mass) * g * math.sin(theta)
+    return StaticLuffingForces(F_L, M, geo.lever, T, masses[1] * g * math.sin(theta) + 2 * T)
