@@ -63,7 +63,7 @@ def build_model(scene: dict) -> tuple[Model, np.ndarray, np.ndarray]:
         if bc["kind"] == "sleeve":
             v = bc["speed"]
             s_fun = (lambda t, s0=s_end, v=v: s0 + v * t, lambda t, v=v: v, lambda t: 0.0)
-            Qd0[offsets[ib] + b.s_coord(0 if end == "left" else len(b.elements))] = v
+            Qd0[offsets[ib]:offsets[ib] + b.n_coords] += _axial_flow_velocity(b, end, v, d)
         cons.append(boundary_condition(offsets, beams, ib, end, bc["kind"], pos, direction, s_fun,
                                        fix_torsion=eff["torsion"]))
         constrained_ends.add((ib, end))
@@ -99,3 +99,19 @@ def _no_torsion(offsets, beams) -> LinearConstraint:
     z = np.zeros(len(rows))
     return LinearConstraint("no_torsion", [{i: 1.0} for i in rows],
                             lambda t: z, lambda t: z, lambda t: z)
+
+
+def _axial_flow_velocity(b: Beam, end: str, v: float, d: np.ndarray) -> np.ndarray:
+    """Initial coordinate rates of a straight beam whose material slides rigidly through a
+    sleeve at the ``end`` node with ds/dt = v there (other breakpoints are material points):
+    material velocity -v d everywhere, node rates r_dot_k = -v d + d s_dot_k (Eq. 1)."""
+    qd = np.zeros(b.n_coords)
+    nb = len(b.elements)
+    s_rate = np.zeros(nb + 1)
+    s_rate[0 if end == "left" else nb] = v
+    for e, (el, imap) in enumerate(zip(b.elements, b.index_map)):
+        for k in range(el.n):
+            sk = s_rate[e] + (s_rate[e + 1] - s_rate[e]) * k / (el.n - 1)
+            qd[imap[el.index("r", k, 0):el.index("r", k, 0) + 3]] = -v * d + d * sk
+        qd[imap[el.i_s1]], qd[imap[el.i_sn]] = s_rate[e], s_rate[e + 1]
+    return qd

@@ -1,0 +1,8 @@
+"""Test-session settings: single-threaded BLAS (the models are small; threading only adds
+overhead and contention on the 2-core CI machine)."""
+
+import os
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("MKL_NUM_THREADS", "1")
