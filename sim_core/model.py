@@ -16,6 +16,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from .beam.moving_node_beam import Beam
+from .constraints import constraint_terms, kkt_accelerations
 from .effects import Effect, ElementContext, PointLoad
 
 _CSTEP = 1e-20   # complex-step size (no subtractive cancellation, any tiny value works)
@@ -48,6 +49,8 @@ class Model:
     effects: list[Effect]
     point_loads: list[PointLoad] = field(default_factory=list)
     constraints: list[LinearConstraint] = field(default_factory=list)
+    nonlinear: list = field(default_factory=list)          # constraints.NonlinearConstraint
+    baumgarte: tuple[float, float] = (10.0, 10.0)          # xi1, xi2 in 1/s (second seed Eq. 8)
 
     def __post_init__(self):
         self.offsets = np.cumsum([0] + [b.n_coords for b in self.beams])[:-1]
@@ -173,8 +176,26 @@ class Model:
         return self.reduced_mass_force(t, q, v)
 
     def accelerations(self, t: float, z: np.ndarray, zd: np.ndarray) -> np.ndarray:
+        return self.accelerations_and_multipliers(t, z, zd)[0]
+
+    def accelerations_and_multipliers(self, t: float, z: np.ndarray, zd: np.ndarray):
+        """z_ddot and the multipliers of the nonlinear constraints (empty if there are none)."""
         Mr, Fr = self.reduced_mass_force(t, z, zd)
-        return sla.solve(Mr, Fr, assume_a="pos")
+        if not self.nonlinear:
+            return sla.solve(Mr, Fr, assume_a="pos"), np.zeros(0)
+        Q, Qd = self.full_state(t, z, zd)
+        phi, J, dphi, c_rhs = constraint_terms(self.nonlinear, t, Q, Qd)
+        xi1, xi2 = self.baumgarte
+        Qdd_p = self.A_pinv @ self._b(t, 2)
+        c_rhs = c_rhs - J @ Qdd_p - 2.0 * xi1 * dphi - xi2 ** 2 * phi
+        return kkt_accelerations(Mr, Fr, J @ self.P, c_rhs)
+
+    def constraint_violation(self, t: float, z: np.ndarray, zd: np.ndarray) -> np.ndarray:
+        """Position-level violation of every nonlinear constraint row (m or rad)."""
+        if not self.nonlinear:
+            return np.zeros(0)
+        Q, Qd = self.full_state(t, z, zd)
+        return constraint_terms(self.nonlinear, t, Q, Qd)[0]
 
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
         """First-order right-hand side for y = (z, z_dot)."""
@@ -186,8 +207,11 @@ class Model:
         """Constraint multipliers lambda (one per constraint row): A^T lambda = M Q_ddot - F."""
         Q, Qd = self.full_state(t, z, zd)
         M, F = self.mass_force(t, Q, Qd)
-        Qdd = self.A_pinv @ self._b(t, 2) + self.P @ self.accelerations(t, z, zd)
-        return self.A_pinv.T @ (M @ Qdd - F)
+        zdd, lam = self.accelerations_and_multipliers(t, z, zd)
+        R = M @ (self.A_pinv @ self._b(t, 2) + self.P @ zdd) - F
+        if self.nonlinear:
+            R = R - constraint_terms(self.nonlinear, t, Q, Qd)[1].T @ lam
+        return self.A_pinv.T @ R
 
     # -- energies ----------------------------------------------------------------------------
     def energies(self, t: float, Q: np.ndarray, Qd: np.ndarray, gravity=None) -> dict:

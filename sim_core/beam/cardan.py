@@ -38,6 +38,7 @@ class SectionState:
     tmat : (G, 3, 3) map from (alpha, beta, gamma) rates to angular velocity in section frame
         components (omega_s, omega_t, omega_b) (Eq. 31 / Appendix A).
     frame : (G, 3, 3) rows e_t, e_b, e_s in global components.
+    psi_prime : (G, 3) (alpha', beta', gamma'), 1/m.
     """
 
     eps: np.ndarray
@@ -46,6 +47,7 @@ class SectionState:
     dpsi_drp: np.ndarray
     tmat: np.ndarray
     frame: np.ndarray
+    psi_prime: np.ndarray | None = None   # (G, 3) arc-length derivatives (alpha', beta', gamma')
 
 
 def cardan_frame(alpha, beta, gamma) -> np.ndarray:
@@ -154,4 +156,5 @@ def section_state(rp: np.ndarray, rpp: np.ndarray, gam: np.ndarray, gamp: np.nda
 
     frame = cardan_frame(alpha, beta, gam) @ basis.T
     angles = np.stack([alpha, beta, gam], axis=1)
-    return SectionState(eps, d, angles, dpsi, tmat, frame)
+    psi_prime = np.stack([ap, bp, gamp], axis=1)
+    return SectionState(eps, d, angles, dpsi, tmat, frame, psi_prime)

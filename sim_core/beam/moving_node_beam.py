@@ -89,6 +89,7 @@ class PointKinematics:
     J_w: np.ndarray          # (G, 3, nq) angular velocity Jacobian (section-frame components)
     B_xi: np.ndarray | None  # (G, 4, nq) strain Jacobian at fixed xi
     B_s: np.ndarray | None   # (G, 4, nq) strain Jacobian at fixed s (material)
+    J_psi: np.ndarray | None = None   # (G, 3, nq) Cardan angles (alpha, beta, gamma) at fixed s
 
 
 class SplineElement:
@@ -181,8 +182,8 @@ class SplineElement:
             xi = self.q_xi.astype(np.result_type(ell, float))
             s = (s1 + (sub + self.q_xi) * ell).real
         else:
-            s = np.atleast_1d(np.asarray(s, float))
-            sub = self.locate(qe, s) if sub is None else np.atleast_1d(sub)
+            s = np.atleast_1d(np.asarray(s))          # complex allowed (complex-step in s)
+            sub = self.locate(qe, s.real) if sub is None else np.atleast_1d(sub)
             xi = (s - s1) / ell - sub                                  # Eq. 10
         Gn = len(s)
         dt = np.result_type(qe, float)
@@ -262,7 +263,7 @@ class SplineElement:
                 eps_prime = np.einsum("gij,gj->gi", sec.deps_dx, xprime)
                 B_s = B_xi.copy()
                 B_s[:, :, chi] -= eps_prime[:, :, None] * ds_dchi[:, None, :]
-        return PointKinematics(s, np.asarray(sub), ell, r, rp, sec, J_r, J_w, B_xi, B_s)
+        return PointKinematics(s, np.asarray(sub), ell, r, rp, sec, J_r, J_w, B_xi, B_s, dpsi)
 
     def strain_energy_density(self, kin: PointKinematics) -> np.ndarray:
         """W = eps^T D eps / 2 at the points (J/m)."""

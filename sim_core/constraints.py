@@ -1,0 +1,147 @@
+"""Nonlinear (holonomic) constraints with Lagrange multipliers and Baumgarte stabilization.
+
+A constraint is  g(Q) - b(t) = 0  with m rows acting on a subset of the coordinates.  The
+model solves the index-1 form at acceleration level,
+
+    [ M_r   C^T ] [ z_ddot ]   [ F_r                                              ]
+    [ C     0   ] [ -lambda] = [ b_ddot - g_QQ[Q_dot, Q_dot] - g_Q Q_ddot_p
+                                 - 2 xi1 (g_Q Q_dot - b_dot) - xi2^2 (g - b)    ]
+
+with C = g_Q P (second seed, Eq. 8: Phi_ddot + 2 xi1 Phi_dot + xi2^2 Phi = 0).  The quadratic
+velocity term g_QQ[Q_dot, Q_dot] is the complex-step derivative of g_Q(Q + i h Q_dot) Q_dot.
+The position-level violation |g - b| is reported as an output so drift is visible.
+
+Zhao-Qi-Wang 2024 Section 6 (Constraints I and II: centroids coincide, Cardan angles agree)
+are built with :func:`point_coincidence` and :func:`angle_coincidence` from material points
+whose arc-length coordinate may itself be a state variable (the inner contact point s_2,k).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+Vec = np.ndarray
+
+
+@dataclass
+class NonlinearConstraint:
+    """Rows g(Q) - b(t) = 0.
+
+    ``evaluate(Q)`` returns (g (m,), g_Q (m, N)) and must be complex-step safe in Q.
+    ``target`` returns (b, b_dot, b_ddot) at time t (rheonomic drives); None means b = 0.
+    """
+
+    name: str
+    m: int
+    evaluate: Callable[[Vec], tuple[Vec, Vec]]
+    target: Callable[[float], tuple[Vec, Vec, Vec]] | None = None
+
+    def b(self, t: float):
+        if self.target is None:
+            z = np.zeros(self.m)
+            return z, z, z
+        return tuple(np.atleast_1d(np.asarray(x, float)) for x in self.target(t))
+
+
+_H = 1e-20
+
+
+def constraint_terms(cons: list[NonlinearConstraint], t: float, Q: Vec, Qd: Vec):
+    """Stacked (violation Phi, Jacobian g_Q, velocity violation Phi_dot, b_ddot - g_QQ[Qd,Qd])."""
+    phis, jacs, dphis, rhs = [], [], [], []
+    for c in cons:
+        g, J = c.evaluate(Q)
+        _, Jc = c.evaluate(Q + 1j * _H * Qd)
+        quad = (Jc @ Qd).imag / _H
+        b, bd, bdd = c.b(t)
+        phis.append(np.real(g) - b)
+        jacs.append(np.real(J))
+        dphis.append(np.real(J) @ Qd - bd)
+        rhs.append(bdd - quad)
+    return (np.concatenate(phis), np.vstack(jacs), np.concatenate(dphis), np.concatenate(rhs))
+
+
+def kkt_accelerations(Mr: Vec, Fr: Vec, C: Vec, c_rhs: Vec):
+    """Solve the saddle-point system; returns (z_ddot, lambda) with M z_ddot = F + C^T lambda."""
+    n, m = Mr.shape[0], C.shape[0]
+    K = np.zeros((n + m, n + m))
+    K[:n, :n] = Mr
+    K[:n, n:] = C.T
+    K[n:, :n] = C
+    sol = np.linalg.solve(K, np.concatenate([Fr, c_rhs]))
+    return sol[:n], -sol[n:]
+
+
+def material_point(model, ibeam: int, s_fixed: float | None = None, s_index: int | None = None):
+    """Function Q -> (r (3,), dr/dQ (3, N), psi (3,), dpsi/dQ (3, N)) of a point of a beam.
+
+    The point is the material point s_fixed, or the spatial point whose material coordinate is
+    the generalized coordinate Q[s_index] (e.g. the inner contact point s_2,k, Section 5-6):
+    d r/dQ = dr/dQ|_s + r' ds/dQ  (Eq. 1 in coordinates).  Complex-step safe.
+    """
+    beam = model.beams[ibeam]
+    off = int(model.offsets[ibeam])
+    N = model.n_coords
+
+    def f(Q):
+        s = Q[s_index] if s_index is not None else s_fixed
+        e = model._element_at(ibeam, Q.real, float(np.real(s)))
+        idx = off + beam.index_map[e]
+        el = beam.elements[e]
+        kin = el.evaluate(Q[idx], s=np.array([s]), strains=False)
+        J = np.zeros((3, N), dtype=kin.J_r.dtype)
+        Jp = np.zeros((3, N), dtype=kin.J_r.dtype)
+        J[:, idx] = kin.J_r[0]
+        Jp[:, idx] = kin.J_psi[0]
+        if s_index is not None:
+            J[:, s_index] += kin.rp[0]
+            Jp[:, s_index] += kin.sec.psi_prime[0]
+        return kin.r[0], J, kin.sec.angles[0], Jp
+
+    return f
+
+
+
+def _fixed(value):
+    v = np.asarray(value, float)
+    z = np.zeros_like(v)
+    return lambda t: (v, z, z)
+
+
+def point_coincidence(name: str, fa, fb=None, fixed=None) -> NonlinearConstraint:
+    """Centroids coincide: r_a(Q) - r_b(Q) = 0, or r_a(Q) = fixed (Section 6, Eq. 47)."""
+    def evaluate(Q):
+        ra, Ja, _, _ = fa(Q)
+        if fb is None:
+            return ra, Ja
+        rb, Jb, _, _ = fb(Q)
+        return ra - rb, Ja - Jb
+    return NonlinearConstraint(name, 3, evaluate, None if fixed is None else _fixed(fixed))
+
+
+def angle_coincidence(name: str, fa, fb=None, fixed=None) -> NonlinearConstraint:
+    """Orientations agree: Psi_a - Psi_b = 0 (Cardan angles in a common basis, Eq. 48)."""
+    def evaluate(Q):
+        _, _, pa, Ja = fa(Q)
+        if fb is None:
+            return pa, Ja
+        _, _, pb, Jb = fb(Q)
+        return pa - pb, Ja - Jb
+    return NonlinearConstraint(name, 3, evaluate, None if fixed is None else _fixed(fixed))
+
+
+def distance_driver(name: str, fa, fb, length) -> NonlinearConstraint:
+    """|r_a - r_b| = L(t): a massless actuator imposing a distance (cylinder, drive).
+
+    ``length(t)`` returns (L, L_dot, L_ddot); the multiplier is the actuator force (N),
+    positive in tension."""
+    def evaluate(Q):
+        ra, Ja, _, _ = fa(Q)
+        rb, Jb, _, _ = fb(Q)
+        d = ra - rb
+        n = np.sqrt(d @ d)
+        return np.atleast_1d(n), ((d / n) @ (Ja - Jb))[None, :]
+    return NonlinearConstraint(name, 1, evaluate, length)
