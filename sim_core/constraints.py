@@ -75,13 +75,18 @@ def kkt_accelerations(Mr: Vec, Fr: Vec, C: Vec, c_rhs: Vec):
     return sol[:n], -sol[n:]
 
 
-def material_point(model, ibeam: int, s_fixed: float | None = None, s_index: int | None = None):
+def material_point(model, ibeam: int, s_fixed: float | None = None, s_index: int | None = None,
+                   offset=None):
     """Function Q -> (r (3,), dr/dQ (3, N), psi (3,), dpsi/dQ (3, N)) of a point of a beam.
 
     The point is the material point s_fixed, or the spatial point whose material coordinate is
     the generalized coordinate Q[s_index] (e.g. the inner contact point s_2,k, Section 5-6):
     d r/dQ = dr/dQ|_s + r' ds/dQ  (Eq. 1 in coordinates).  Complex-step safe.
+    ``offset`` (axial, lateral, vertical) in m is a rigid offset in the section frame
+    (e_s, e_t, e_b), e.g. the luffing pivot D1 and cylinder head D3 (Section 9, Fig. 13a):
+    r_o = r + o_s e_s + o_t e_t + o_b e_b,  dr_o = dr + delta_phi x o  (delta_phi = frame^T dw).
     """
+    o_sec = None if offset is None else np.asarray(offset, float)
     beam = model.beams[ibeam]
     off = int(model.offsets[ibeam])
     N = model.n_coords
@@ -99,7 +104,17 @@ def material_point(model, ibeam: int, s_fixed: float | None = None, s_index: int
         if s_index is not None:
             J[:, s_index] += kin.rp[0]
             Jp[:, s_index] += kin.sec.psi_prime[0]
-        return kin.r[0], J, kin.sec.angles[0], Jp
+        r = kin.r[0]
+        if o_sec is not None:
+            frame = kin.sec.frame[0]                      # rows e_t, e_b, e_s (global)
+            o = o_sec[1] * frame[0] + o_sec[2] * frame[1] + o_sec[0] * frame[2]
+            # small global rotation per dQ; tmat gives section components ordered (s, t, b)
+            rot = frame[[2, 0, 1]].T @ (kin.sec.tmat[0] @ Jp)
+            J = J + np.stack([rot[1] * o[2] - rot[2] * o[1],      # delta_phi x o
+                              rot[2] * o[0] - rot[0] * o[2],
+                              rot[0] * o[1] - rot[1] * o[0]])
+            r = r + o
+        return r, J, kin.sec.angles[0], Jp
 
     return f
 

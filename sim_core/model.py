@@ -50,11 +50,13 @@ class Model:
     point_loads: list[PointLoad] = field(default_factory=list)
     constraints: list[LinearConstraint] = field(default_factory=list)
     nonlinear: list = field(default_factory=list)          # constraints.NonlinearConstraint
+    point_effects: list = field(default_factory=list)      # point_effects.PointMass, RopeDrive
+    n_extra: int = 0            # extra coordinates after the beams (e.g. inner contact points s_2,k)
     baumgarte: tuple[float, float] = (10.0, 10.0)          # xi1, xi2 in 1/s (second seed Eq. 8)
 
     def __post_init__(self):
         self.offsets = np.cumsum([0] + [b.n_coords for b in self.beams])[:-1]
-        self.n_coords = int(sum(b.n_coords for b in self.beams))
+        self.n_coords = int(sum(b.n_coords for b in self.beams)) + int(self.n_extra)
         self.needs = frozenset().union(*(e.needs for e in self.effects)) if self.effects else frozenset()
         self._reduce()
 
@@ -136,6 +138,8 @@ class Model:
             np.add.at(F, idx, Fe)
         for pl in self.point_loads:
             self._add_point_load(pl, t, Q, F)
+        for pe in self.point_effects:
+            pe.add(t, Q, Qd, M, F)
         return M, F
 
     def _add_point_load(self, pl: PointLoad, t: float, Q: np.ndarray, F: np.ndarray) -> None:

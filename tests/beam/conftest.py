@@ -1,7 +1,6 @@
 """Shared builders for single-beam tests (a slender steel-like beam, SI units)."""
 
 import numpy as np
-import pytest
 
 from sim_core.assemble import reference_basis
 from sim_core.beam.moving_node_beam import Beam, BeamSection
@@ -32,8 +31,3 @@ def cantilever(n_nodes=9, breakpoints=(0.0, L), effects=None, loads=(), gravity=
     m = Model([b], eff, list(loads), cons)
     Q0 = b.straight_coordinates([0, 0, 0], [1, 0, 0])
     return m, Q0
-
-
-@pytest.fixture
-def rng():
-    return np.random.default_rng(12345)

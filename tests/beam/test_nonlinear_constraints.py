@@ -8,7 +8,7 @@ clamp eliminated exactly, at any state consistent with the constraints.
 import numpy as np
 
 from sim_core.constraints import angle_coincidence, material_point, point_coincidence
-from sim_core.effects import Gravity, PointLoad
+from sim_core.effects import PointLoad
 from sim_core.model import Model, boundary_condition
 from tests.beam.conftest import cantilever
 

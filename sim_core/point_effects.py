@@ -1,0 +1,75 @@
+"""Effects acting at points of the bodies: payload point mass, rope drives over pulleys.
+
+Each has ``add(t, Q, Qd, M, F)`` on the full coordinates and is assembled only when the scene
+contains it.  Points are functions Q -> (r, dr/dQ, psi, dpsi/dQ) from
+:func:`sim_core.constraints.material_point` (material points with optional rigid offsets).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable, Sequence
+
+import numpy as np
+
+_H = 1e-20
+
+
+@dataclass
+class PointMass:
+    """A point mass m (kg) rigidly attached at a point (payload at the tip of the innermost boom,
+    Zhao-Qi-Wang 2024 Section 9): M += m J^T J,  F += m J^T (g - J_dot q_dot)."""
+
+    point: Callable
+    mass: float
+    gravity: np.ndarray | None = None
+    name: str = "payload"
+
+    def add(self, t, Q, Qd, M, F):
+        _, J, _, _ = self.point(Q)
+        _, Jc, _, _ = self.point(Q + 1j * _H * Qd)
+        acc = (Jc @ Qd).imag / _H
+        if M is not None:
+            M += self.mass * (J.T @ J)
+        f = -self.mass * acc
+        if self.gravity is not None:
+            f = f + self.mass * self.gravity
+        F += J.T @ f
+
+
+@dataclass
+class RopeDrive:
+    """Elastic, massless, tension-only rope over frictionless point pulleys (Section 9; SCENARIOS
+    A3): length l(Q) = sum |r_{i+1} - r_i| over anchor, pulleys, anchor; tension
+    T = (EA/L0) * ramp(l - L0) with a C1 ramp over ``slack_width`` (m) so the switch to slack is
+    smooth; generalized force F -= T dl/dQ."""
+
+    points: Sequence[Callable]
+    EA: float
+    L0: float
+    slack_width: float = 1e-6
+    name: str = "rope"
+
+    def length(self, Q):
+        pts = [p(Q) for p in self.points]
+        ell = 0.0
+        grad = np.zeros(len(Q))
+        for (ra, Ja, _, _), (rb, Jb, _, _) in zip(pts[:-1], pts[1:]):
+            d = rb - ra
+            n = np.sqrt(d @ d)
+            ell = ell + n
+            grad = grad + (d / n) @ (Jb - Ja)
+        return ell, grad
+
+    def tension(self, ell):
+        x = (ell - self.L0) / self.slack_width
+        k = self.EA / self.L0
+        if x <= 0:
+            return 0.0
+        if x >= 1:
+            return k * (ell - self.L0 - 0.5 * self.slack_width)
+        return k * self.slack_width * 0.5 * x * x
+
+    def add(self, t, Q, Qd, M, F):
+        ell, grad = self.length(Q)
+        F -= self.tension(float(np.real(ell))) * np.real(grad)

@@ -1,0 +1,227 @@
+"""Telescopic boom system of Zhao-Qi-Wang 2024 (Sections 2, 5-7, 9): nested flexible booms with
+moving contact constraints, luffing cylinder, telescopic cylinder, ropes and payload.
+
+Status: contact *resultants* (Constraints I and II with their multipliers, Section 6-7) are in;
+the sliding-block contact distribution and friction of Section 8 are not yet coupled (the
+solver is in sim_core.contact), so the sliding joints are frictionless here.
+
+Booms are numbered from the outermost (1).  Each boom is two moving-node spline elements split
+at its outer contact point (boom 1: at the luffing point s = L_h, a material point, Eq. 50);
+the end nodes are material points (s_1,k = 0, s_4,k = L_k, Eq. 50).  The inner contact point of
+boom k < N is not a node: its arc-length coordinate s_2,k is an extra generalized coordinate
+(Section 5) and the point is interpolated with Eq. 6.
+
+Constraint I (Eq. 47): centroid and Cardan angles of boom k+1's left end = those of boom k at
+s_2,k.  Constraint II (Eq. 48): boom k's right end = boom k+1's outer-contact node s_3,k+1.
+Their multipliers are the contact force/moment resultants; the generalized forces they exert
+on s_2,k and s_3,k+1 are the contact multipliers eta of Section 7 (zero without friction).
+
+Mounting and drives (SCENARIOS A2-A4, proposed defaults): revolute pivot D1 about Y (rigid
+offset from boom 1's left section), luffing cylinder = massless rigid rod D2-D3 of constant
+length (its multiplier is the cylinder force), telescopic cylinder = massless actuator imposing
+the distance L_s(t) between the left-section centres of booms 1 and 2, elastic tension-only
+extraction and retraction ropes over point pulleys, payload point mass at boom N's tip.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .assemble import reference_basis
+from .beam.moving_node_beam import Beam, BeamSection
+from .constraints import (NonlinearConstraint, angle_coincidence, distance_driver, material_point,
+                          point_coincidence)
+from .drive_profiles import CubicSmoothstepSchedule
+from .effects import Effect, Elasticity, Gravity, Inertia, StressFilter
+from .model import Model, boundary_condition, fix_material_coordinate
+from .point_effects import PointMass, RopeDrive
+from .validation.closed_form import luffing_geometry, static_luffing_forces
+
+# SCENARIOS A1 Table 2 (EI_t = EI_b, GJ, m'), EA = E m'/rho (proposed default)
+TABLE2 = ((7.22e8, 5.55e8, 318.86), (6.30e8, 4.85e8, 304.07), (5.46e8, 4.20e8, 289.27))
+
+
+@dataclass
+class TelescopicParams:
+    """Inputs of the paper's telescopic scenes (SI units; defaults = paper Section 9.2)."""
+
+    n_booms: int = 3
+    boom_length: float = 10.0               # m
+    luffing_angle_deg: float = 60.0         # deg
+    stroke0: float = 2.0                    # m, initial piston-rod length L_s
+    direction: int = +1                     # +1 extraction, -1 retraction
+    L_h: float = 7.25                       # m, luffing point on boom 1
+    E: float = 2.1e11                       # Pa (2.1e12: the nearly rigid case 9.1)
+    rho: float = 7850.0                     # kg/m^3
+    payload: float = 25000.0                # kg
+    rope_EA: float = 1e8                    # N
+    gravity: float = 9.81                   # m/s^2 along -Z
+    n_nodes: int = 9                        # nodes per spline element (8 sub-elements)
+    n_gauss: int = 5
+    filter_h: float = 0.01                  # s, 0 = off
+    v_max: float = 0.5                      # m/s, schedule of A4
+    t_ramp: float = 4.0
+    t_hold_end: float = 12.0
+    baumgarte: tuple[float, float] = (20.0, 20.0)
+    sections: tuple = field(default=TABLE2)
+
+
+def boom_section(k: int, p: TelescopicParams) -> BeamSection:
+    EI, GJ, m = p.sections[min(k, len(p.sections) - 1)]
+    scale = p.E / 2.1e11                   # case 9.1: stiffnesses x10, masses unchanged
+    I = EI / 2.1e11                         # second moment from Table 2
+    return BeamSection(EA=p.E * m / p.rho, GJ=GJ * scale, EI_t=EI * scale, EI_b=EI * scale,
+                       rhoA=m, J_s=2 * p.rho * I, J_t=p.rho * I, J_b=p.rho * I)
+
+
+@dataclass
+class TelescopicSystem:
+    model: Model
+    Q0: np.ndarray
+    schedule: CubicSmoothstepSchedule
+    s2_index: list[int]                     # coordinates of the inner contact points s_2,k
+    s3_index: list[int]                     # coordinates of the outer contact points s_3,k
+    rows: dict[str, slice]                  # nonlinear-constraint rows by name
+    tip: callable                           # point function of the tip (boom N, s = L)
+    params: TelescopicParams
+
+
+def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
+    theta = np.radians(p.luffing_angle_deg)
+    geo = luffing_geometry(theta)
+    e = np.asarray(geo.e_s, float)
+    O1 = np.asarray(geo.origin, float)
+    L, N, Ls = p.boom_length, p.n_booms, p.stroke0
+    G = reference_basis(e)
+    beams = []
+    for k in range(N):
+        split = p.L_h if k == 0 else L - Ls
+        beams.append(Beam(f"boom{k + 1}", L, boom_section(k, p), (0.0, split, L),
+                          n_nodes=p.n_nodes, n_gauss=p.n_gauss, reference_basis=G))
+    offsets = np.cumsum([0] + [b.n_coords for b in beams])[:-1]
+    g_vec = np.array([0.0, 0.0, -p.gravity])
+    effects: list[Effect] = [Inertia(), Elasticity()]
+    if p.filter_h > 0:
+        effects.append(StressFilter(p.filter_h))
+    if p.gravity > 0:
+        effects.append(Gravity(g_vec))
+    lin = []
+    for ib in range(N):
+        for end in ("left", "right"):
+            lin.append(boundary_condition(offsets, beams, ib, end, "free"))
+    lin.append(fix_material_coordinate(offsets, beams, 0, 1, p.L_h))
+    model = Model(beams, effects, [], lin, n_extra=N - 1, baumgarte=p.baumgarte)
+
+    # initial straight configuration: boom k's left section a_k = k L_s along boom 1 (A3)
+    Q0 = np.zeros(model.n_coords)
+    for k, b in enumerate(beams):
+        Q0[offsets[k]:offsets[k] + b.n_coords] = b.straight_coordinates(O1 + k * Ls * e, e)
+    n_beam = int(sum(b.n_coords for b in beams))
+    s2_index = [n_beam + k for k in range(N - 1)]
+    Q0[s2_index] = Ls
+    s3_index = [int(offsets[k] + beams[k].s_coord(1)) for k in range(N)]
+
+    def mp(k, **kw):
+        return material_point(model, k, **kw)
+
+    def fixed_point(r):
+        r = np.asarray(r, float)
+
+        def f(Q):
+            Z = np.zeros((3, len(Q)))
+            return r, Z, np.zeros(3), Z
+        return f
+
+    cons: list[NonlinearConstraint] = []
+    names: list[tuple[str, int]] = []
+
+    def add(c):
+        cons.append(c)
+        names.append((c.name, c.m))
+
+    # pivot D1: revolute about Y (point fixed, beta = gamma = 0 at boom 1's left section)
+    D1 = mp(0, s_fixed=0.0, offset=(-0.956, 0.0, 0.556))
+    add(point_coincidence("pivot", D1, fixed=geo.d1))
+    root = mp(0, s_fixed=0.0)
+    add(_rows(angle_coincidence("pivot_axis", root, fixed=[0.0, 0.0, 0.0]), [1, 2]))
+    # luffing cylinder: rigid massless rod D2-D3 held at its initial length (A2)
+    D3 = mp(0, s_fixed=p.L_h, offset=(0.0, 0.0, -0.556))
+    Lc = float(geo.cylinder_length)
+    add(distance_driver("luffing_cylinder", D3, fixed_point(geo.d2), lambda t: (Lc, 0.0, 0.0)))
+    # contact constraints I and II between adjacent booms (Section 6)
+    for k in range(N - 1):
+        inner = mp(k, s_index=s2_index[k])
+        left_next = mp(k + 1, s_fixed=0.0)
+        add(point_coincidence(f"I_{k + 1}{k + 2}_point", left_next, inner))
+        add(angle_coincidence(f"I_{k + 1}{k + 2}_angles", left_next, inner))
+        right = mp(k, s_fixed=L)
+        outer_next = mp(k + 1, s_index=s3_index[k + 1])
+        add(point_coincidence(f"II_{k + 1}{k + 2}_point", right, outer_next))
+        add(angle_coincidence(f"II_{k + 1}{k + 2}_angles", right, outer_next))
+    # telescopic cylinder between the left sections of booms 1 and 2 (A3, A4)
+    sched = CubicSmoothstepSchedule(v_max=p.v_max, t_ramp=p.t_ramp, t_hold_end=p.t_hold_end,
+                                    sign=p.direction, s0=Ls)
+    add(distance_driver("telescopic_cylinder", mp(1, s_fixed=0.0), mp(0, s_fixed=0.0),
+                        lambda t: (sched.stroke(t), sched.rate(t), sched.accel(t))))
+    model.nonlinear = cons
+    rows, i = {}, 0
+    for nm, m in names:
+        rows[nm] = slice(i, i + m)
+        i += m
+
+    tip = mp(N - 1, s_fixed=L)
+    pe = []
+    if p.payload > 0:
+        pe.append(PointMass(tip, p.payload, g_vec if p.gravity > 0 else None))
+    if N >= 3:
+        rope_scale = p.E / 2.1e11
+        ext = [mp(0, s_fixed=0.0, offset=(0.05, 0, 0)), mp(1, s_fixed=9.0),
+               mp(2, s_fixed=0.0, offset=(-0.04, 0, 0))]
+        ret = [mp(0, s_fixed=L, offset=(0.68, 0, 0)), mp(1, s_fixed=0.66),
+               mp(2, s_fixed=0.0, offset=(0.64, 0, 0))]
+        EA = p.rope_EA * rope_scale
+        rope = RopeDrive(ext, EA, 1.0, name="extraction_rope")
+        ell_e = float(rope.length(Q0)[0])
+        # unstretched length from the static rope tension T = (m3 + m_p) g sin(theta) (C7)
+        T0 = static_luffing_forces(theta, Ls, p.payload, g=p.gravity).rope_tension
+        rope.L0 = ell_e / (1.0 + T0 / EA)
+        retr = RopeDrive(ret, EA, 1.0, name="retraction_rope")
+        retr.L0 = float(retr.length(Q0)[0])         # just taut
+        pe += [rope, retr]
+    model.point_effects = pe
+    return TelescopicSystem(model, Q0, sched, s2_index, s3_index, rows, tip, p)
+
+
+def _rows(c: NonlinearConstraint, keep: list[int]) -> NonlinearConstraint:
+    """A constraint restricted to some of its rows."""
+    ev = c.evaluate
+    tgt = c.target
+
+    def evaluate(Q):
+        g, J = ev(Q)
+        return g[keep], J[keep]
+
+    def target(t):
+        b, bd, bdd = tgt(t)
+        return b[keep], bd[keep], bdd[keep]
+    return NonlinearConstraint(c.name, len(keep), evaluate, None if tgt is None else target)
+
+
+def initial_equilibrium(ts: TelescopicSystem, t: float = 0.0):
+    """Static equilibrium at t = 0 with the rope lengths of SCENARIOS A3: the retraction rope is
+    'just taut' *at the equilibrium*: it is slack while the equilibrium is solved, then its
+    unstretched length is set to its length there (zero tension, no change of the equilibrium).
+    Returns (z, lambda)."""
+    from .statics import constrained_static_equilibrium
+    m = ts.model
+    z0, _ = m.reduced_state(t, ts.Q0, np.zeros_like(ts.Q0))
+    retr = [pe for pe in m.point_effects if pe.name == "retraction_rope"]
+    for r in retr:
+        r.L0 = np.inf
+    z, lam = constrained_static_equilibrium(m, z0, t)
+    Q, _ = m.full_state(t, z, np.zeros_like(z))
+    for r in retr:
+        r.L0 = float(r.length(Q)[0])
+    return z, lam
