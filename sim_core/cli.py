@@ -1,7 +1,9 @@
 """Command line: ``boom-sim run|list|describe|plot``.
 
-Errors in the scene exit with status 2 and a one-line message; a failed solve exits with
-status 3 and a one-line message (time and reason).
+Errors in the scene (or an unreadable result file for ``plot``) exit with status 2 and a
+one-line message; a failed solve exits with status 3 and a one-line message (time and reason),
+after writing summary.json with the error and, if the solver attached one to the
+SimulationError (``.result``), the partial result.npz.
 """
 
 from __future__ import annotations
@@ -9,10 +11,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-import time
 from pathlib import Path
-
-import numpy as np
 
 from .errors import SceneError, SimulationError
 from .result import Result, atomic_write_bytes
@@ -53,31 +52,89 @@ class _Progress:
         self.bar.set_postfix_str(f"RTF {t / max(wall, 1e-9):.3g}")
         self.bar.refresh()
 
-    def close(self):
+    def close(self, finished: bool = True):
         if self.bar is not None:
-            self.bar.n = self.t_end
+            if finished:
+                self.bar.n = self.t_end
             self.bar.close()
+            self.bar = None
+
+
+def _one_line(msg: object) -> str:
+    return " ".join(str(msg).split())
+
+
+def _partial_result(exc: SimulationError) -> Result | None:
+    """The outputs up to the failure, if the solver attached them to the error
+    (``exc.result`` or ``exc.partial_result``, a :class:`Result`)."""
+    for name in ("result", "partial_result"):
+        res = getattr(exc, name, None)
+        if isinstance(res, Result):
+            return res
+    return None
 
 
 def cmd_run(args) -> int:
-    from .plots import plot_result
     from .simulate import simulate
     scene = load_scene(args.scene, _overrides(args.set))
     out = Path(args.out)
     prog = _Progress(scene["solver"]["t_end"], not args.quiet)
     try:
         result = simulate(scene, progress=prog)
-    finally:
-        prog.close()
+    except SimulationError as exc:
+        prog.close(finished=False)
+        note = _save_failure(scene, out, exc)
+        print(f"boom-sim: {_one_line(exc)}{note}", file=sys.stderr)
+        return 3
+    prog.close()
     result.save(out / "result.npz")
     summary = {"scene": scene["name"], **result.stats}
-    atomic_write_bytes(out / "summary.json", json.dumps(summary, indent=2).encode())
-    figs = [] if args.no_plots else plot_result(result, out)
+    atomic_write_bytes(out / "summary.json", json.dumps(summary, indent=2, default=str).encode())
+    figs = [] if args.no_plots else _plots(result, out)
     print(f"{scene['name']}: {scene['solver']['t_end']:g} s simulated in "
           f"{result.stats['wall_time_s']:.1f} s wall (RTF {result.stats['real_time_factor']:.3g}); "
           f"{result.stats['n_steps']} steps, {result.stats['n_rhs']} RHS; wrote {out}/result.npz, "
           f"summary.json" + (f", {len(figs)} figures" if figs else ""))
     return 0
+
+
+def _save_failure(scene: dict, out: Path, exc: SimulationError) -> str:
+    """Keep what a failed run produced: the partial result (if the solver attached one, with
+    ``error`` set) and a summary.json naming the failure.  Returns a note for the one-line
+    message.  Never raises (the SimulationError is what the user must see); a file that cannot
+    be written is reported on stderr."""
+    partial = _partial_result(exc)
+    summary = {"scene": scene["name"], "error": _one_line(exc), "t_fail_s": exc.t,
+               "step_s": exc.step, "result_file": None}
+    try:
+        if partial is not None:
+            if partial.error is None:
+                partial.error = _one_line(exc)
+            if not partial.scene:
+                partial.scene = scene
+            partial.save(out / "result.npz")
+            summary["result_file"] = "result.npz"
+            summary.update({k: v for k, v in partial.stats.items() if k not in summary})
+        atomic_write_bytes(out / "summary.json", json.dumps(summary, indent=2, default=str).encode())
+    except Exception as w:  # noqa: BLE001 - report and go on to the exit status 3
+        print(f"boom-sim: warning: could not write the failed run's files to {out}: {_one_line(w)}",
+              file=sys.stderr)
+        return ""
+    if partial is None:
+        return f"; no partial result (summary.json written to {out})"
+    t_last = float(partial.t[-1]) if len(partial.t) else 0.0
+    return f"; partial result up to t = {t_last:.6g} s written to {out / 'result.npz'}"
+
+
+def _plots(result: Result, out: Path) -> list:
+    """Figures; a missing matplotlib only skips them (the result files are already written)."""
+    try:
+        import matplotlib  # noqa: F401
+    except ImportError:
+        print("boom-sim: warning: matplotlib is not installed, figures skipped", file=sys.stderr)
+        return []
+    from .plots import plot_result
+    return plot_result(result, out)
 
 
 def cmd_list(args) -> int:
@@ -90,23 +147,42 @@ def cmd_list(args) -> int:
 def cmd_describe(args) -> int:
     from .assemble import build_model
     scene = load_scene(args.scene, _overrides(args.set))
-    model, _, _ = build_model(scene)
+    if scene.get("kind") == "telescopic":
+        from .telescopic import build_telescopic
+        from .telescopic_scene import params_from_scene
+        model = build_telescopic(params_from_scene(scene)).model
+    else:
+        model, _, _ = build_model(scene)
     print(f"scene {scene['name']}: {scene['description']}")
     print("effects: " + ", ".join(f"{k}={'on' if v else 'off'}" for k, v in scene["effects"].items()))
     print("assembled contributions: " + ", ".join(e.name for e in model.effects)
+          + "".join(f", {pe.name}" for pe in model.point_effects)
           + (f", {len(model.point_loads)} point load(s)" if model.point_loads else ""))
-    print(f"coordinates: {model.n_coords}, constraints: {model.A.shape[0]}, DOF: {model.n_dof}")
+    n_nl = sum(c.m for c in model.nonlinear)
+    print(f"coordinates: {model.n_coords}, linear constraints: {model.A.shape[0]}, "
+          f"nonlinear constraint rows: {n_nl}, DOF: {model.n_dof - n_nl}")
     print(json.dumps({k: v for k, v in scene.items() if k != "source"}, indent=2))
     return 0
 
 
 def cmd_plot(args) -> int:
-    from .plots import plot_result
-    res = Result.load(args.result)
+    try:
+        res = Result.load(args.result)
+    except (OSError, ValueError, KeyError) as exc:
+        raise _InputError(f"cannot read result file {args.result!r}: {_one_line(exc)}") from None
     out = Path(args.out) if args.out else Path(args.result).parent
+    try:
+        import matplotlib  # noqa: F401
+    except ImportError:
+        raise _InputError("matplotlib is not installed (pip install matplotlib)") from None
+    from .plots import plot_result
     figs = plot_result(res, out)
     print(f"wrote {len(figs)} figures to {out}")
     return 0
+
+
+class _InputError(Exception):
+    """A bad command-line input other than a scene (exit status 2)."""
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -132,10 +208,13 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return args.func(args)
     except SceneError as exc:
-        print(f"boom-sim: scene error: {exc}", file=sys.stderr)
+        print(f"boom-sim: scene error: {_one_line(exc)}", file=sys.stderr)
+        return 2
+    except _InputError as exc:
+        print(f"boom-sim: error: {_one_line(exc)}", file=sys.stderr)
         return 2
     except SimulationError as exc:
-        print(f"boom-sim: {exc}", file=sys.stderr)
+        print(f"boom-sim: {_one_line(exc)}", file=sys.stderr)
         return 3
 
 

@@ -13,7 +13,12 @@ import numpy as np
 
 
 def atomic_write_bytes(path: str | Path, data: bytes) -> None:
-    """Write ``data`` to ``path`` through a temporary file in the same folder + rename."""
+    """Write ``data`` to ``path`` through a temporary file in the same folder + rename.
+
+    Readers see either the old file or the complete new one; on any failure the temporary file
+    is removed and an existing ``path`` is left untouched.  The new file gets the usual
+    permissions (those of the file it replaces, else 0666 less the umask), not mkstemp's 0600.
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
@@ -22,11 +27,58 @@ def atomic_write_bytes(path: str | Path, data: bytes) -> None:
             f.write(data)
             f.flush()
             os.fsync(f.fileno())
+        os.chmod(tmp, _mode_for(path))
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
             os.unlink(tmp)
         raise
+    _fsync_dir(path.parent)
+
+
+def _mode_for(path: Path) -> int:
+    try:
+        return path.stat().st_mode & 0o7777
+    except OSError:
+        return 0o666 & ~_umask()
+
+
+def _umask() -> int:
+    try:  # Linux: read it without changing it (os.umask would, briefly, for every thread)
+        with open("/proc/self/status") as f:
+            for line in f:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    umask = os.umask(0o022)
+    os.umask(umask)
+    return umask
+
+
+def _fsync_dir(folder: Path) -> None:
+    """Make the rename durable (best effort: not every OS/file system allows it)."""
+    try:
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+def _json_default(obj):
+    """numpy scalars/arrays as plain numbers/lists in the metadata (anything else as text)."""
+    if isinstance(obj, np.generic):
+        return obj.item()
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    if isinstance(obj, Path):
+        return str(obj)
+    return str(obj)
 
 
 @dataclass
@@ -69,7 +121,7 @@ class Result:
         except ImportError:  # pragma: no cover
             pass
         buf = io.BytesIO()
-        np.savez_compressed(buf, t=self.t, __meta__=np.array(json.dumps(meta, default=str)),
+        np.savez_compressed(buf, t=self.t, __meta__=np.array(json.dumps(meta, default=_json_default)),
                             **{f"out__{k}": v for k, v in self.outputs.items()})
         atomic_write_bytes(path, buf.getvalue())
         return Path(path)

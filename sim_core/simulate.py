@@ -29,7 +29,7 @@ class _CountingRHS:
         self.nfev += 1
         self.last_t = t
         try:
-            with np.errstate(all="raise"):
+            with np.errstate(over="raise", divide="raise", invalid="raise", under="ignore"):
                 out = self.model.rhs(t, y)
         except (FloatingPointError, np.linalg.LinAlgError) as exc:
             raise SimulationError(t, f"non-finite or singular dynamics: {exc}", last_state=y) from None
@@ -79,6 +79,14 @@ def simulate(scene: dict, progress=None) -> Result:
     ``element_ends`` (material coordinates of all breakpoints, m) and ``reactions`` (one column
     per constraint row, N or N m).
     """
+    if scene.get("kind") == "telescopic":
+        from .telescopic import simulate_telescopic
+        from .telescopic_scene import params_from_scene
+        sol = scene["solver"]
+        res = simulate_telescopic(params_from_scene(scene), sol["t_end"], sol["n_output"],
+                                  sol["rtol"], sol["atol"], progress)
+        res.scene = scene
+        return res
     model, Q0, Qd0 = build_model(scene)
     sol = scene["solver"]
     z0, zd0 = model.reduced_state(0.0, Q0, Qd0)

@@ -103,11 +103,25 @@ def constrained_static_equilibrium(model: Model, z0: np.ndarray, t: float = 0.0,
             K[:, j] = ((Fj + Cj.T @ lam) - r1) / h
         m = C.shape[0]
         A = np.block([[K, C.T], [C, np.zeros((m, m))]])
-        d = np.linalg.solve(A, -np.concatenate([r1, phi]))
-        z = z + d[:n]
-        lam = lam + d[n:]
-        Fr, phi, C = parts(z)
-        if np.linalg.norm(d[:n]) <= 1e-13 * (1.0 + np.linalg.norm(z)):   # stalled at round-off
+        try:
+            d = np.linalg.solve(A, -np.concatenate([r1, phi]))
+        except np.linalg.LinAlgError:
+            raise SimulationError(t, "constrained static equilibrium: singular tangent") from None
+        # backtracking on the merit |r| + k_ref |phi| (k_ref: force per metre of the tangent)
+        k_ref = float(np.max(np.abs(np.diag(K)))) or 1.0
+        merit0 = np.linalg.norm(r1) + k_ref * np.linalg.norm(phi)
+        step = 1.0
+        while True:
+            z_try, lam_try = z + step * d[:n], lam + step * d[n:]
+            Fr_t, phi_t, C_t = parts(z_try)
+            merit = np.linalg.norm(Fr_t + C_t.T @ lam_try) + k_ref * np.linalg.norm(phi_t)
+            if (np.isfinite(merit) and merit < merit0) or step < 1e-3:
+                break
+            step *= 0.5
+        if not np.isfinite(merit):
+            raise SimulationError(t, "constrained static equilibrium: non-finite residual")
+        z, lam, Fr, phi, C = z_try, lam_try, Fr_t, phi_t, C_t
+        if step * np.linalg.norm(d[:n]) <= 1e-13 * (1.0 + np.linalg.norm(z)):   # stalled
             return z, lam
     raise SimulationError(t, "constrained static equilibrium: Newton did not converge "
                              f"(|r| = {np.linalg.norm(Fr + C.T @ lam):.3g} N, |phi| = {np.max(np.abs(phi)):.3g})")

@@ -225,3 +225,69 @@ def initial_equilibrium(ts: TelescopicSystem, t: float = 0.0):
     for r in retr:
         r.L0 = float(r.length(Q)[0])
     return z, lam
+
+
+def _section_resultants(ts: TelescopicSystem, Q: np.ndarray, lam: np.ndarray, name: str,
+                        point) -> np.ndarray:
+    """Constraint force (global multipliers of the centroid rows) and moment (from the Cardan-
+    angle multipliers, m = T^-T lambda_psi) in the section frame (s, t, b) of the contact point."""
+    r, J, psi, Jp = point(Q)
+    f_glob = lam[ts.rows[name + "_point"]]
+    lam_psi = lam[ts.rows[name + "_angles"]]
+    from .beam.cardan import cardan_frame
+    frame = cardan_frame(*psi) @ ts.model.beams[0].reference_basis.T     # rows e_t, e_b, e_s
+    sb, cb = np.sin(psi[1]), np.cos(psi[1])
+    sg, cg = np.sin(psi[2]), np.cos(psi[2])
+    T = np.array([[sb, 0.0, 1.0], [cb * cg, sg, 0.0], [-cb * sg, cg, 0.0]])   # Eq. 31
+    m_sec = np.linalg.solve(T.T, lam_psi)                                  # (s, t, b)
+    f_sec = np.array([frame[2] @ f_glob, frame[0] @ f_glob, frame[1] @ f_glob])
+    return np.concatenate([f_sec, m_sec])
+
+
+def simulate_telescopic(p: TelescopicParams, t_end: float = 20.0, n_output: int = 201,
+                        rtol: float = 1e-6, atol: float = 1e-7, progress=None):
+    """Run the telescopic scene from its static equilibrium and return a Result with the
+    public outputs of the telescopic contract (tip kinematics, piston stroke, cylinder forces,
+    contact-point resultants, contact coordinates, constraint violation)."""
+    from .result import Result
+    from .simulate import integrate_rk45
+    ts = build_telescopic(p)
+    m = ts.model
+    z0, _ = initial_equilibrium(ts)
+    n = m.n_dof
+    t, ys, stats = integrate_rk45(m, np.concatenate([z0, 0 * z0]), t_end,
+                                  {"rtol": rtol, "atol": atol, "n_output": n_output}, progress)
+    N = p.n_booms
+    out = {k: [] for k in ("tip_position", "tip_velocity", "tip_acceleration", "piston_stroke",
+                           "luffing_cylinder_force", "telescopic_cylinder_force",
+                           "contact_point_forces", "inner_contact_s", "outer_contact_s",
+                           "constraint_violation")}
+    left1 = material_point(m, 0, s_fixed=0.0)
+    left2 = material_point(m, 1, s_fixed=0.0)
+    for tk, y in zip(t, ys):
+        z, zd = y[:n], y[n:]
+        zdd, lam = m.accelerations_and_multipliers(tk, z, zd)
+        Q, Qd = m.full_state(tk, z, zd)
+        Qdd = m.A_pinv @ m._b(tk, 2) + m.P @ zdd
+        r, J, _, _ = ts.tip(Q)
+        _, Jc, _, _ = ts.tip(Q + 1e-20j * Qd)
+        out["tip_position"].append(r)
+        out["tip_velocity"].append(J @ Qd)
+        out["tip_acceleration"].append(J @ Qdd + (Jc @ Qd).imag / 1e-20)
+        out["piston_stroke"].append(np.linalg.norm(left2(Q)[0] - left1(Q)[0]) - p.stroke0)
+        out["luffing_cylinder_force"].append(lam[ts.rows["luffing_cylinder"]][0])
+        out["telescopic_cylinder_force"].append(lam[ts.rows["telescopic_cylinder"]][0])
+        cpf = []
+        for k in range(N - 1):
+            inner = material_point(m, k, s_index=ts.s2_index[k])
+            outer = material_point(m, k + 1, s_index=ts.s3_index[k + 1])
+            cpf.append([_section_resultants(ts, Q, lam, f"I_{k + 1}{k + 2}", inner),
+                        _section_resultants(ts, Q, lam, f"II_{k + 1}{k + 2}", outer)])
+        out["contact_point_forces"].append(cpf)
+        out["inner_contact_s"].append(Q[ts.s2_index])
+        out["outer_contact_s"].append(Q[ts.s3_index[1:]])
+        out["constraint_violation"].append(np.max(np.abs(m.constraint_violation(tk, z, zd))))
+    outputs = {k: np.array(v, dtype=float) for k, v in out.items()}
+    stats["n_dof"] = int(n)
+    scene = {"name": "telescopic", "params": {k: v for k, v in p.__dict__.items() if k != "sections"}}
+    return Result(t, outputs, stats, scene)

@@ -1,0 +1,99 @@
+"""Scene schema of the telescopic boom system (kind = "telescopic"), SI units.
+
+  kind = "telescopic", name, description
+  [solver]     t_end s (> 0), rtol (0, 1), atol (> 0), n_output (>= 2), method ("RK45")
+  [booms]      count (2..5; ropes only for 3), length m (> 0), luffing_angle_deg (0..85),
+               stroke0 m (piston-rod length L_s at t = 0, > 0), L_h m (luffing point on boom 1,
+               within (0, length)), E Pa (> 0), rho kg/m^3 (> 0), n_nodes (3..33 per spline
+               element; paper 9), n_gauss (1..10)
+  [drive]      direction ("extraction"/"retraction"), v_max m/s (> 0), t_ramp s (> 0),
+               t_hold_end s (>= t_ramp)  -- the cubic schedule of Section 9 (SCENARIOS A4)
+  [payload]    mass kg (>= 0)
+  [ropes]      EA N (> 0)
+  [effects]    gravity (bool), filtering (bool)
+  [filtering]  h s (> 0)
+  [gravity]    g m/s^2 (> 0, along -Z)
+Geometry rules: the stroke history must keep each boom inside its neighbour: with L_s(t) the
+piston length, 0 < L_s(t) < length for all t in [0, t_end] (error names drive/booms fields).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from .errors import SceneError
+from .scene import boolean, check_keys, choice, number
+
+_TOP = {"kind", "name", "description", "solver", "booms", "drive", "payload", "ropes", "effects",
+        "filtering", "gravity", "notes"}
+
+
+def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
+    check_keys(raw, _TOP, "scene")
+    sc: dict[str, Any] = {"kind": "telescopic", "name": str(raw.get("name", "telescopic")),
+                          "description": str(raw.get("description", "")), "source": source}
+    s = raw.get("solver", {})
+    check_keys(s, {"t_end", "rtol", "atol", "n_output", "method"}, "solver")
+    sc["solver"] = {"t_end": number(s, "t_end", "solver", 20.0, lo=0.0, lo_open=True),
+                    "rtol": number(s, "rtol", "solver", 1e-6, lo=0.0, hi=1.0, lo_open=True, hi_open=True),
+                    "atol": number(s, "atol", "solver", 1e-7, lo=0.0, lo_open=True),
+                    "n_output": number(s, "n_output", "solver", 201, lo=2, integer=True),
+                    "method": choice(s, "method", "solver", ("RK45",), "RK45")}
+    b = raw.get("booms", {})
+    check_keys(b, {"count", "length", "luffing_angle_deg", "stroke0", "L_h", "E", "rho",
+                   "n_nodes", "n_gauss"}, "booms")
+    L = number(b, "length", "booms", 10.0, lo=0.0, lo_open=True)
+    sc["booms"] = {"count": number(b, "count", "booms", 3, lo=2, hi=5, integer=True),
+                   "length": L,
+                   "luffing_angle_deg": number(b, "luffing_angle_deg", "booms", 60.0, lo=0.0, hi=85.0),
+                   "stroke0": number(b, "stroke0", "booms", 2.0, lo=0.0, hi=L, lo_open=True, hi_open=True),
+                   "L_h": number(b, "L_h", "booms", 7.25, lo=0.0, hi=L, lo_open=True, hi_open=True),
+                   "E": number(b, "E", "booms", 2.1e11, lo=0.0, lo_open=True),
+                   "rho": number(b, "rho", "booms", 7850.0, lo=0.0, lo_open=True),
+                   "n_nodes": number(b, "n_nodes", "booms", 9, lo=3, hi=33, integer=True),
+                   "n_gauss": number(b, "n_gauss", "booms", 5, lo=1, hi=10, integer=True)}
+    d = raw.get("drive", {})
+    check_keys(d, {"direction", "v_max", "t_ramp", "t_hold_end"}, "drive")
+    t_ramp = number(d, "t_ramp", "drive", 4.0, lo=0.0, lo_open=True)
+    sc["drive"] = {"direction": choice(d, "direction", "drive", ("extraction", "retraction"), "extraction"),
+                   "v_max": number(d, "v_max", "drive", 0.5, lo=0.0, lo_open=True),
+                   "t_ramp": t_ramp,
+                   "t_hold_end": number(d, "t_hold_end", "drive", 12.0, lo=t_ramp)}
+    travel = sc["drive"]["v_max"] * sc["drive"]["t_hold_end"]
+    sign = 1 if sc["drive"]["direction"] == "extraction" else -1
+    end = sc["booms"]["stroke0"] + sign * travel
+    if not 0.0 < end < L:
+        raise SceneError(f"drive: the stroke history moves L_s from {sc['booms']['stroke0']:g} m to "
+                         f"{end:g} m, outside the allowed (0, {L:g}) m (booms.length): a boom would "
+                         f"leave its neighbour; reduce drive.v_max or drive.t_hold_end "
+                         f"(v_max * t_hold_end <= {(L - sc['booms']['stroke0']) if sign > 0 else sc['booms']['stroke0']:g} m)")
+    pl = raw.get("payload", {})
+    check_keys(pl, {"mass"}, "payload")
+    sc["payload"] = {"mass": number(pl, "mass", "payload", 25000.0, lo=0.0)}
+    r = raw.get("ropes", {})
+    check_keys(r, {"EA"}, "ropes")
+    sc["ropes"] = {"EA": number(r, "EA", "ropes", 1e8, lo=0.0, lo_open=True)}
+    e = raw.get("effects", {})
+    check_keys(e, {"gravity", "filtering"}, "effects")
+    sc["effects"] = {"gravity": boolean(e, "gravity", "effects", True),
+                     "filtering": boolean(e, "filtering", "effects", True)}
+    f = raw.get("filtering", {})
+    check_keys(f, {"h"}, "filtering")
+    sc["filtering"] = {"h": number(f, "h", "filtering", 0.01, lo=0.0, lo_open=True)}
+    g = raw.get("gravity", {})
+    check_keys(g, {"g"}, "gravity")
+    sc["gravity"] = {"g": number(g, "g", "gravity", 9.81, lo=0.0, lo_open=True)}
+    return sc
+
+
+def params_from_scene(sc: dict):
+    """TelescopicParams of a validated telescopic scene."""
+    from .telescopic import TelescopicParams
+    b, d = sc["booms"], sc["drive"]
+    return TelescopicParams(
+        n_booms=b["count"], boom_length=b["length"], luffing_angle_deg=b["luffing_angle_deg"],
+        stroke0=b["stroke0"], direction=1 if d["direction"] == "extraction" else -1, L_h=b["L_h"],
+        E=b["E"], rho=b["rho"], payload=sc["payload"]["mass"], rope_EA=sc["ropes"]["EA"],
+        gravity=sc["gravity"]["g"] if sc["effects"]["gravity"] else 0.0, n_nodes=b["n_nodes"],
+        n_gauss=b["n_gauss"], filter_h=sc["filtering"]["h"] if sc["effects"]["filtering"] else 0.0,
+        v_max=d["v_max"], t_ramp=d["t_ramp"], t_hold_end=d["t_hold_end"])
