@@ -78,3 +78,18 @@ def test_rigid_limit_extraction_follows_paper_kinematics(rigid_equilibrium):
         assert r[0] == pytest.approx(ref.x[k], abs=1e-4)
         assert r[2] == pytest.approx(ref.z[k], abs=1e-4)
         assert np.max(np.abs(m.constraint_violation(tk, y[:m.n_dof], y[m.n_dof:]))) < 1e-8
+
+
+def test_retraction_start_static_forces():
+    """Retraction scene start (L_s = 8 m, booms 1 and 3 no longer overlap): C7 forces, 0.5 %."""
+    p = TelescopicParams(n_nodes=3, E=2.1e12, payload=1000.0, stroke0=8.0, direction=-1)
+    ts = build_telescopic(p)
+    z, lam = initial_equilibrium(ts)
+    ref = static_luffing_forces(np.radians(60.0), 8.0, 1000.0, z_c=(0.0, 0.0, 0.0))
+    assert abs(lam[ts.rows["luffing_cylinder"]][0]) == pytest.approx(ref.luffing_force, rel=5e-3)
+    assert abs(lam[ts.rows["telescopic_cylinder"]][0]) == pytest.approx(ref.telescopic_force, rel=5e-3)
+    # tip near the rigid start point of SCENARIOS A9 (13.404, 23.417) m: E = 2.1e12 sag < 1 cm
+    Q, _ = ts.model.full_state(0.0, z, np.zeros_like(z))
+    r = ts.tip(Q)[0]
+    assert r[0] == pytest.approx(13.4035, abs=1e-2)
+    assert r[2] == pytest.approx(23.4166, abs=1e-2)
