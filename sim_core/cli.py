@@ -157,6 +157,7 @@ def cmd_describe(args) -> int:
     print("effects: " + ", ".join(f"{k}={'on' if v else 'off'}" for k, v in scene["effects"].items()))
     print("assembled contributions: " + ", ".join(e.name for e in model.effects)
           + "".join(f", {pe.name}" for pe in model.point_effects)
+          + "".join(f", {mf.name}" for mf in model.multiplier_forces)
           + (f", {len(model.point_loads)} point load(s)" if model.point_loads else ""))
     n_nl = sum(c.m for c in model.nonlinear)
     print(f"coordinates: {model.n_coords}, linear constraints: {model.A.shape[0]}, "

@@ -64,6 +64,22 @@ def constraint_terms(cons: list[NonlinearConstraint], t: float, Q: Vec, Qd: Vec)
     return (np.concatenate(phis), np.vstack(jacs), np.concatenate(dphis), np.concatenate(rhs))
 
 
+def kkt_factor(Mr: Vec, C: Vec):
+    """LU-factor the saddle-point matrix once; returns solve(Fr, c_rhs) -> (z_ddot, lambda)."""
+    import scipy.linalg as sla
+    n, m = Mr.shape[0], C.shape[0]
+    K = np.zeros((n + m, n + m))
+    K[:n, :n] = Mr
+    K[:n, n:] = C.T
+    K[n:, :n] = C
+    lu = sla.lu_factor(K)
+
+    def solve(Fr, c_rhs):
+        sol = sla.lu_solve(lu, np.concatenate([Fr, c_rhs]))
+        return sol[:n], -sol[n:]
+    return solve
+
+
 def kkt_accelerations(Mr: Vec, Fr: Vec, C: Vec, c_rhs: Vec):
     """Solve the saddle-point system; returns (z_ddot, lambda) with M z_ddot = F + C^T lambda."""
     n, m = Mr.shape[0], C.shape[0]

@@ -16,7 +16,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from .beam.moving_node_beam import Beam
-from .constraints import constraint_terms, kkt_accelerations
+from .constraints import constraint_terms, kkt_accelerations, kkt_factor
 from .effects import Effect, ElementContext, PointLoad
 
 _CSTEP = 1e-20   # complex-step size (no subtractive cancellation, any tiny value works)
@@ -52,6 +52,11 @@ class Model:
     nonlinear: list = field(default_factory=list)          # constraints.NonlinearConstraint
     point_effects: list = field(default_factory=list)      # point_effects.PointMass, RopeDrive
     n_extra: int = 0            # extra coordinates after the beams (e.g. inner contact points s_2,k)
+    # forces that depend on the constraint multipliers (contact friction, Section 8.3): objects
+    # with forces(t, Q, Qd, lam) -> (N,); solved by fixed-point iteration on lambda
+    multiplier_forces: list = field(default_factory=list)
+    multiplier_tol: float = 1e-8
+    multiplier_max_iter: int = 8
     baumgarte: tuple[float, float] = (10.0, 10.0)          # xi1, xi2 in 1/s (second seed Eq. 8)
 
     def __post_init__(self):
@@ -192,7 +197,18 @@ class Model:
         xi1, xi2 = self.baumgarte
         Qdd_p = self.A_pinv @ self._b(t, 2)
         c_rhs = c_rhs - J @ Qdd_p - 2.0 * xi1 * dphi - xi2 ** 2 * phi
-        return kkt_accelerations(Mr, Fr, J @ self.P, c_rhs)
+        if not self.multiplier_forces:
+            return kkt_accelerations(Mr, Fr, J @ self.P, c_rhs)
+        solve = kkt_factor(Mr, J @ self.P)
+        zdd, lam = solve(Fr, c_rhs)
+        for _ in range(self.multiplier_max_iter):
+            dF = sum(mf.forces(t, Q, Qd, lam) for mf in self.multiplier_forces)
+            zdd, lam_new = solve(Fr + self.P.T @ dF, c_rhs)
+            change = np.max(np.abs(lam_new - lam)) / max(np.max(np.abs(lam_new)), 1.0)
+            lam = lam_new
+            if change < self.multiplier_tol:
+                break
+        return zdd, lam
 
     def constraint_violation(self, t: float, z: np.ndarray, zd: np.ndarray) -> np.ndarray:
         """Position-level violation of every nonlinear constraint row (m or rad)."""

@@ -65,6 +65,12 @@ class TelescopicParams:
     t_ramp: float = 4.0
     t_hold_end: float = 12.0
     baumgarte: tuple[float, float] = (20.0, 20.0)
+    friction: bool = False                  # sliding-block contact + Coulomb friction (Sec. 8)
+    mu_static: float = 0.15
+    mu_dynamic: float = 0.1
+    v_eps: float = 0.01                     # m/s, switching speed
+    spring_k0: float = 1e9                  # N/m per radial spring (SCENARIOS A6)
+    spring_eps: float = 1e-6                # m, smoothing interval
     sections: tuple = field(default=TABLE2)
 
 
@@ -191,7 +197,15 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
         retr.L0 = float(retr.length(Q0)[0])         # just taut
         pe += [rope, retr]
     model.point_effects = pe
-    return TelescopicSystem(model, Q0, sched, s2_index, s3_index, rows, tip, p)
+    ts = TelescopicSystem(model, Q0, sched, s2_index, s3_index, rows, tip, p)
+    if p.friction:
+        from .contact_friction import ContactFriction
+        if N != 3:
+            raise ValueError(f"friction with n_booms = {N}: the slider geometry is the paper's "
+                             "three-boom section (allowed: 3)")
+        model.multiplier_forces = [ContactFriction(ts, p.mu_static, p.mu_dynamic, p.v_eps,
+                                                   p.spring_k0, p.spring_eps)]
+    return ts
 
 
 def _rows(c: NonlinearConstraint, keep: list[int]) -> NonlinearConstraint:

@@ -10,7 +10,10 @@
                t_hold_end s (>= t_ramp)  -- the cubic schedule of Section 9 (SCENARIOS A4)
   [payload]    mass kg (>= 0)
   [ropes]      EA N (> 0)
-  [effects]    gravity (bool), filtering (bool)
+  [effects]    gravity (bool), filtering (bool), friction (bool: sliding-block contact
+               distribution + Coulomb friction of Section 8; off = frictionless resultants only)
+  [contact]    mu_static (>= 0), mu_dynamic (>= 0), v_eps m/s (> 0, switching speed),
+               k0 N/m (> 0, radial spring stiffness), eps m (> 0, stiffness smoothing interval)
   [filtering]  h s (> 0)
   [gravity]    g m/s^2 (> 0, along -Z)
 Geometry rules: the stroke history must keep each boom inside its neighbour: with L_s(t) the
@@ -25,7 +28,7 @@ from .errors import SceneError
 from .scene import boolean, check_keys, choice, number
 
 _TOP = {"kind", "name", "description", "solver", "booms", "drive", "payload", "ropes", "effects",
-        "filtering", "gravity", "notes"}
+        "filtering", "gravity", "contact", "notes"}
 
 
 def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
@@ -74,9 +77,20 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
     check_keys(r, {"EA"}, "ropes")
     sc["ropes"] = {"EA": number(r, "EA", "ropes", 1e8, lo=0.0, lo_open=True)}
     e = raw.get("effects", {})
-    check_keys(e, {"gravity", "filtering"}, "effects")
+    check_keys(e, {"gravity", "filtering", "friction"}, "effects")
     sc["effects"] = {"gravity": boolean(e, "gravity", "effects", True),
-                     "filtering": boolean(e, "filtering", "effects", True)}
+                     "filtering": boolean(e, "filtering", "effects", True),
+                     "friction": boolean(e, "friction", "effects", False)}
+    if sc["effects"]["friction"] and sc["booms"]["count"] != 3:
+        raise SceneError(f"effects.friction = true with booms.count = {sc['booms']['count']}: the "
+                         "slider geometry is the paper's three-boom section (allowed: 3)")
+    c = raw.get("contact", {})
+    check_keys(c, {"mu_static", "mu_dynamic", "v_eps", "k0", "eps"}, "contact")
+    sc["contact"] = {"mu_static": number(c, "mu_static", "contact", 0.15, lo=0.0),
+                     "mu_dynamic": number(c, "mu_dynamic", "contact", 0.1, lo=0.0),
+                     "v_eps": number(c, "v_eps", "contact", 0.01, lo=0.0, lo_open=True),
+                     "k0": number(c, "k0", "contact", 1e9, lo=0.0, lo_open=True),
+                     "eps": number(c, "eps", "contact", 1e-6, lo=0.0, lo_open=True)}
     f = raw.get("filtering", {})
     check_keys(f, {"h"}, "filtering")
     sc["filtering"] = {"h": number(f, "h", "filtering", 0.01, lo=0.0, lo_open=True)}
@@ -96,4 +110,7 @@ def params_from_scene(sc: dict):
         E=b["E"], rho=b["rho"], payload=sc["payload"]["mass"], rope_EA=sc["ropes"]["EA"],
         gravity=sc["gravity"]["g"] if sc["effects"]["gravity"] else 0.0, n_nodes=b["n_nodes"],
         n_gauss=b["n_gauss"], filter_h=sc["filtering"]["h"] if sc["effects"]["filtering"] else 0.0,
-        v_max=d["v_max"], t_ramp=d["t_ramp"], t_hold_end=d["t_hold_end"])
+        v_max=d["v_max"], t_ramp=d["t_ramp"], t_hold_end=d["t_hold_end"],
+        friction=sc["effects"]["friction"], mu_static=sc["contact"]["mu_static"],
+        mu_dynamic=sc["contact"]["mu_dynamic"], v_eps=sc["contact"]["v_eps"],
+        spring_k0=sc["contact"]["k0"], spring_eps=sc["contact"]["eps"])

@@ -1,0 +1,77 @@
+"""Frictional sliding-block contact between adjacent booms (Zhao-Qi-Wang 2024, Section 8).
+
+For every contact region (pair k, k+1; region I at boom k's inner contact section s_2,k and
+region II at boom k+1's outer contact section s_3,k+1) the constraint reaction of Constraint I or
+II (force and moment, section frame) is distributed on the sliders' radial springs by the
+micro-motion solver (Eqs. 59-71, :mod:`sim_core.contact.sliding_block_contact`); the friction
+force mu(s_dot) * sum(f_ij) (Eq. 65, regularised law of SCENARIOS A6) acts along e_s.  Its
+virtual power under a relative slide is  -mu(s_dot) N delta s_dot  (Section 7: the contact
+multiplier eta), so it enters the equations as the generalized force -mu(s_dot) N on the contact
+coordinate s_2,k or s_3,k+1.  Because N depends on the multipliers, the model iterates the
+multipliers to a fixed point (Model.multiplier_forces).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .beam.cardan import cardan_frame
+from .contact import FrictionLaw, SliderGeometry, SpringLaw, solve_micro_motion
+
+
+def section_reaction(point, Q, lam_point, lam_angles, basis):
+    """Force and moment (section components (s, t, b)) that a coincidence constraint with
+    multipliers (lam_point, lam_angles) exerts on its *second* body b (g = r_a - r_b): -lambda,
+    the moment from the Cardan-angle multipliers m = T^-T lambda_psi (Eq. 31)."""
+    _, _, psi, _ = point(Q)
+    frame = cardan_frame(*psi) @ basis.T                 # rows e_t, e_b, e_s (global)
+    sb, cb = np.sin(psi[1]), np.cos(psi[1])
+    sg, cg = np.sin(psi[2]), np.cos(psi[2])
+    T = np.array([[sb, 0.0, 1.0], [cb * cg, sg, 0.0], [-cb * sg, cg, 0.0]])
+    m_sec = -np.linalg.solve(T.T, lam_angles)
+    f = -np.asarray(lam_point)
+    f_sec = np.array([frame[2] @ f, frame[0] @ f, frame[1] @ f])
+    return f_sec, m_sec
+
+
+class ContactFriction:
+    """Multiplier-dependent friction forces on the contact coordinates of all regions."""
+
+    name = "friction"
+
+    def __init__(self, ts, mu_static: float, mu_dynamic: float, v_eps: float,
+                 k0: float = 1e9, eps: float = 1e-6):
+        self.ts = ts
+        self.law = FrictionLaw(mu_static, mu_dynamic, v_eps)
+        self.spring = SpringLaw(k0, eps)
+        self.basis = ts.model.beams[0].reference_basis
+        from .constraints import material_point
+        m = ts.model
+        self.regions = []
+        for k in range(ts.params.n_booms - 1):
+            inner = material_point(m, k, s_index=ts.s2_index[k])
+            outer = material_point(m, k + 1, s_index=ts.s3_index[k + 1])
+            self.regions.append((f"I_{k + 1}{k + 2}", inner, ts.s2_index[k],
+                                 SliderGeometry.paper_region(k + 1, "inner")))
+            self.regions.append((f"II_{k + 1}{k + 2}", outer, ts.s3_index[k + 1],
+                                 SliderGeometry.paper_region(k + 1, "outer")))
+        self._x0 = {}
+
+    def solve_regions(self, Q, Qd, lam):
+        """Per region: (name, s_index, mu, ContactSolution)."""
+        rows = self.ts.rows
+        out = []
+        for name, point, s_idx, geom in self.regions:
+            f_c, m_c = section_reaction(point, Q, lam[rows[name + "_point"]],
+                                        lam[rows[name + "_angles"]], self.basis)
+            mu = self.law.mu(float(Qd[s_idx]))
+            sol = solve_micro_motion(geom, self.spring, f_c, m_c, mu, x0=self._x0.get(name))
+            self._x0[name] = sol.x
+            out.append((name, s_idx, mu, sol))
+        return out
+
+    def forces(self, t, Q, Qd, lam):
+        dF = np.zeros(len(Q))
+        for _, s_idx, mu, sol in self.solve_regions(Q, Qd, lam):
+            dF[s_idx] -= mu * sol.total_normal_force
+        return dF
