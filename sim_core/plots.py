@@ -42,6 +42,19 @@ def plot_result(result: Result, out: str | Path) -> list[Path]:
         fig.tight_layout()
         paths.append(_save(fig, out / "tip.png"))
         plt.close(fig)
+    if "luffing_cylinder_force" in result:
+        fig, axes = plt.subplots(2, 1, figsize=(8, 5), sharex=True)
+        axes[0].plot(t, result["luffing_cylinder_force"] / 1e3)
+        axes[0].set_ylabel("luffing cylinder [kN]")
+        axes[1].plot(t, result["telescopic_cylinder_force"] / 1e3)
+        axes[1].set_ylabel("telescopic cylinder [kN]")
+        axes[1].set_xlabel("t [s]")
+        for ax in axes:
+            ax.grid(alpha=0.3)
+        fig.suptitle("cylinder forces (positive = pushing)")
+        fig.tight_layout()
+        paths.append(_save(fig, out / "cylinder_forces.png"))
+        plt.close(fig)
     if "energy_kinetic" in result:
         fig, ax = plt.subplots(figsize=(8, 3))
         for n in ("energy_kinetic", "energy_strain", "energy_gravity"):

@@ -262,7 +262,9 @@ def simulate_telescopic(p: TelescopicParams, t_end: float = 20.0, n_output: int 
                         rtol: float = 1e-6, atol: float = 1e-7, progress=None):
     """Run the telescopic scene from its static equilibrium and return a Result with the
     public outputs of the telescopic contract (tip kinematics, piston stroke, cylinder forces,
-    contact-point resultants, contact coordinates, constraint violation)."""
+    contact-point resultants, contact coordinates, constraint violation; with friction also the
+    normal force of every slider spring per region (I_12, II_12, I_23, II_23; springs ordered arc
+    by arc P1, P2, P3 as in sim_core.contact) and the signed friction coefficient per region)."""
     from .result import Result
     from .simulate import integrate_rk45
     ts = build_telescopic(p)
@@ -298,6 +300,11 @@ def simulate_telescopic(p: TelescopicParams, t_end: float = 20.0, n_output: int 
             cpf.append([_section_resultants(ts, Q, lam, f"I_{k + 1}{k + 2}", inner),
                         _section_resultants(ts, Q, lam, f"II_{k + 1}{k + 2}", outer)])
         out["contact_point_forces"].append(cpf)
+        if m.multiplier_forces:
+            sols = m.multiplier_forces[0].solve_regions(Q, Qd, lam)
+            out.setdefault("contact_spring_forces", []).append(
+                [sol.normal_force for _, _, _, sol in sols])
+            out.setdefault("friction_coefficient", []).append([mu for _, _, mu, _ in sols])
         out["inner_contact_s"].append(Q[ts.s2_index])
         out["outer_contact_s"].append(Q[ts.s3_index[1:]])
         out["constraint_violation"].append(np.max(np.abs(m.constraint_violation(tk, z, zd))))
