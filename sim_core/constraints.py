@@ -142,26 +142,26 @@ def _fixed(value):
     return lambda t: (v, z, z)
 
 
+def _coincidence(name: str, fa, fb, fixed, part: int) -> NonlinearConstraint:
+    """q_a - q_b = 0 (or q_a = fixed) for part 0 (centroid r) or 1 (Cardan angles Psi) of the
+    point functions' (r, dr/dQ, Psi, dPsi/dQ)."""
+    def evaluate(Q):
+        a = fa(Q)
+        if fb is None:
+            return a[2 * part], a[2 * part + 1]
+        b = fb(Q)
+        return a[2 * part] - b[2 * part], a[2 * part + 1] - b[2 * part + 1]
+    return NonlinearConstraint(name, 3, evaluate, None if fixed is None else _fixed(fixed))
+
+
 def point_coincidence(name: str, fa, fb=None, fixed=None) -> NonlinearConstraint:
     """Centroids coincide: r_a(Q) - r_b(Q) = 0, or r_a(Q) = fixed (Section 6, Eq. 47)."""
-    def evaluate(Q):
-        ra, Ja, _, _ = fa(Q)
-        if fb is None:
-            return ra, Ja
-        rb, Jb, _, _ = fb(Q)
-        return ra - rb, Ja - Jb
-    return NonlinearConstraint(name, 3, evaluate, None if fixed is None else _fixed(fixed))
+    return _coincidence(name, fa, fb, fixed, 0)
 
 
 def angle_coincidence(name: str, fa, fb=None, fixed=None) -> NonlinearConstraint:
     """Orientations agree: Psi_a - Psi_b = 0 (Cardan angles in a common basis, Eq. 48)."""
-    def evaluate(Q):
-        _, _, pa, Ja = fa(Q)
-        if fb is None:
-            return pa, Ja
-        _, _, pb, Jb = fb(Q)
-        return pa - pb, Ja - Jb
-    return NonlinearConstraint(name, 3, evaluate, None if fixed is None else _fixed(fixed))
+    return _coincidence(name, fa, fb, fixed, 1)
 
 
 def distance_driver(name: str, fa, fb, length) -> NonlinearConstraint:

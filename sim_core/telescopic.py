@@ -241,23 +241,6 @@ def initial_equilibrium(ts: TelescopicSystem, t: float = 0.0):
     return z, lam
 
 
-def _section_resultants(ts: TelescopicSystem, Q: np.ndarray, lam: np.ndarray, name: str,
-                        point) -> np.ndarray:
-    """Constraint force (global multipliers of the centroid rows) and moment (from the Cardan-
-    angle multipliers, m = T^-T lambda_psi) in the section frame (s, t, b) of the contact point."""
-    r, J, psi, Jp = point(Q)
-    f_glob = lam[ts.rows[name + "_point"]]
-    lam_psi = lam[ts.rows[name + "_angles"]]
-    from .beam.cardan import cardan_frame
-    frame = cardan_frame(*psi) @ ts.model.beams[0].reference_basis.T     # rows e_t, e_b, e_s
-    sb, cb = np.sin(psi[1]), np.cos(psi[1])
-    sg, cg = np.sin(psi[2]), np.cos(psi[2])
-    T = np.array([[sb, 0.0, 1.0], [cb * cg, sg, 0.0], [-cb * sg, cg, 0.0]])   # Eq. 31
-    m_sec = np.linalg.solve(T.T, lam_psi)                                  # (s, t, b)
-    f_sec = np.array([frame[2] @ f_glob, frame[0] @ f_glob, frame[1] @ f_glob])
-    return np.concatenate([f_sec, m_sec])
-
-
 def simulate_telescopic(p: TelescopicParams, t_end: float = 20.0, n_output: int = 201,
                         rtol: float = 1e-6, atol: float = 1e-7, progress=None):
     """Run the telescopic scene from its static equilibrium and return a Result with the
@@ -278,6 +261,8 @@ def simulate_telescopic(p: TelescopicParams, t_end: float = 20.0, n_output: int 
                            "luffing_cylinder_force", "telescopic_cylinder_force",
                            "contact_point_forces", "inner_contact_s", "outer_contact_s",
                            "constraint_violation")}
+    from .contact_friction import section_reaction
+    basis = m.beams[0].reference_basis
     left1 = material_point(m, 0, s_fixed=0.0)
     left2 = material_point(m, 1, s_fixed=0.0)
     for tk, y in zip(t, ys):
@@ -297,8 +282,12 @@ def simulate_telescopic(p: TelescopicParams, t_end: float = 20.0, n_output: int 
         for k in range(N - 1):
             inner = material_point(m, k, s_index=ts.s2_index[k])
             outer = material_point(m, k + 1, s_index=ts.s3_index[k + 1])
-            cpf.append([_section_resultants(ts, Q, lam, f"I_{k + 1}{k + 2}", inner),
-                        _section_resultants(ts, Q, lam, f"II_{k + 1}{k + 2}", outer)])
+            pair = []
+            for name, point in ((f"I_{k + 1}{k + 2}", inner), (f"II_{k + 1}{k + 2}", outer)):
+                f_sec, m_sec = section_reaction(point, Q, lam[ts.rows[name + "_point"]],
+                                                lam[ts.rows[name + "_angles"]], basis)
+                pair.append(np.concatenate([f_sec, m_sec]))
+            cpf.append(pair)
         out["contact_point_forces"].append(cpf)
         if m.multiplier_forces:
             sols = m.multiplier_forces[0].solve_regions(Q, Qd, lam)
