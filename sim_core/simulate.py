@@ -50,25 +50,46 @@ def integrate_rk45(model, y0: np.ndarray, t_end: float, sol: dict, progress=None
     ys = [y0]
     k_out = 1
     steps = []
-    while solver.status == "running":
-        msg = solver.step()
-        if solver.status == "failed" or not np.all(np.isfinite(solver.y)):
-            raise SimulationError(solver.t, f"RK45 failed: {msg}", step=solver.step_size,
-                                  last_state=solver.y)
-        steps.append(solver.t - solver.t_old)
-        if k_out < len(t_eval) and t_eval[k_out] <= solver.t:
-            dense = solver.dense_output()
-            while k_out < len(t_eval) and t_eval[k_out] <= solver.t:
-                ys.append(dense(t_eval[k_out]))
-                k_out += 1
-        if progress is not None:
-            progress(solver.t, time.perf_counter() - wall0)
-    wall = time.perf_counter() - wall0
-    stats = {"wall_time_s": wall, "n_steps": len(steps), "n_rhs": int(rhs.nfev),
-             "min_step_s": float(min(steps)) if steps else 0.0,
-             "max_step_s": float(max(steps)) if steps else 0.0,
-             "method": "RK45", "real_time_factor": t_end / wall}
-    return t_eval[:len(ys)], np.array(ys), stats
+
+    def stats():
+        wall = time.perf_counter() - wall0
+        return {"wall_time_s": wall, "n_steps": len(steps), "n_rhs": int(rhs.nfev),
+                "min_step_s": float(min(steps)) if steps else 0.0,
+                "max_step_s": float(max(steps)) if steps else 0.0,
+                "method": "RK45", "real_time_factor": t_end / max(wall, 1e-12)}
+
+    try:
+        while solver.status == "running":
+            msg = solver.step()
+            if solver.status == "failed" or not np.all(np.isfinite(solver.y)):
+                raise SimulationError(solver.t, f"RK45 failed: {msg}", step=solver.step_size,
+                                      last_state=solver.y)
+            steps.append(solver.t - solver.t_old)
+            if k_out < len(t_eval) and t_eval[k_out] <= solver.t:
+                dense = solver.dense_output()
+                while k_out < len(t_eval) and t_eval[k_out] <= solver.t:
+                    ys.append(dense(t_eval[k_out]))
+                    k_out += 1
+            if progress is not None:
+                progress(solver.t, time.perf_counter() - wall0)
+    except SimulationError as exc:
+        # keep what was computed: the caller turns it into a partial Result (exc.result)
+        exc.partial = (t_eval[:len(ys)], np.array(ys), stats())
+        raise
+    return t_eval[:len(ys)], np.array(ys), stats()
+
+
+def run_with_partial(integrate, collect):
+    """integrate() -> (t, y, stats); collect(t, y, stats, error) -> Result.  On a
+    SimulationError the outputs up to the failure are collected and attached as exc.result."""
+    try:
+        ts, ys, st = integrate()
+    except SimulationError as exc:
+        part = getattr(exc, "partial", None)
+        if part is not None and len(part[0]):
+            exc.result = collect(*part, str(exc))
+        raise
+    return collect(ts, ys, st, None)
 
 
 def simulate(scene: dict, progress=None) -> Result:
@@ -92,11 +113,13 @@ def simulate(scene: dict, progress=None) -> Result:
     z0, zd0 = model.reduced_state(0.0, Q0, Qd0)
     if scene["initial"]["static_equilibrium"]:
         z0 = static_equilibrium(model, z0)
-    n = model.n_dof
     y0 = np.concatenate([z0, zd0])
-    t_end = sol["t_end"]
-    ts, ys, stats = integrate_rk45(model, y0, t_end, sol, progress)
+    return run_with_partial(lambda: integrate_rk45(model, y0, sol["t_end"], sol, progress),
+                            lambda ts, ys, stats, err: _beam_result(model, scene, ts, ys, stats, err))
 
+
+def _beam_result(model, scene, ts, ys, stats, error) -> Result:
+    n = model.n_dof
     g = np.array(scene["gravity"]["g"]) if scene["effects"]["gravity"] else None
     last = len(model.beams) - 1
     L = model.beams[last].length
@@ -121,4 +144,4 @@ def simulate(scene: dict, progress=None) -> Result:
     outputs = {k: np.real(np.array(v, dtype=float)) for k, v in out.items()}
     outputs["state"] = ys
     stats["n_dof"] = int(n)
-    return Result(ts, outputs, stats, scene)
+    return Result(ts, outputs, stats, scene, error)

@@ -248,14 +248,21 @@ def simulate_telescopic(p: TelescopicParams, t_end: float = 20.0, n_output: int 
     contact-point resultants, contact coordinates, constraint violation; with friction also the
     normal force of every slider spring per region (I_12, II_12, I_23, II_23; springs ordered arc
     by arc P1, P2, P3 as in sim_core.contact) and the signed friction coefficient per region)."""
-    from .result import Result
-    from .simulate import integrate_rk45
+    from .simulate import integrate_rk45, run_with_partial
     ts = build_telescopic(p)
     m = ts.model
     z0, _ = initial_equilibrium(ts)
+    y0 = np.concatenate([z0, 0 * z0])
+    return run_with_partial(
+        lambda: integrate_rk45(m, y0, t_end, {"rtol": rtol, "atol": atol, "n_output": n_output},
+                               progress),
+        lambda t, ys, stats, err: _telescopic_result(ts, t, ys, stats, err))
+
+
+def _telescopic_result(ts: TelescopicSystem, t, ys, stats, error):
+    from .result import Result
+    m, p = ts.model, ts.params
     n = m.n_dof
-    t, ys, stats = integrate_rk45(m, np.concatenate([z0, 0 * z0]), t_end,
-                                  {"rtol": rtol, "atol": atol, "n_output": n_output}, progress)
     N = p.n_booms
     out = {k: [] for k in ("tip_position", "tip_velocity", "tip_acceleration", "piston_stroke",
                            "luffing_cylinder_force", "telescopic_cylinder_force",
@@ -300,4 +307,4 @@ def simulate_telescopic(p: TelescopicParams, t_end: float = 20.0, n_output: int 
     outputs = {k: np.array(v, dtype=float) for k, v in out.items()}
     stats["n_dof"] = int(n)
     scene = {"name": "telescopic", "params": {k: v for k, v in p.__dict__.items() if k != "sections"}}
-    return Result(t, outputs, stats, scene)
+    return Result(t, outputs, stats, scene, error)
