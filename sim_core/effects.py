@@ -38,6 +38,35 @@ def _gram(J: np.ndarray, scale: np.ndarray) -> np.ndarray:
     return A.T @ A
 
 
+def _gram_stacked(pairs) -> np.ndarray:
+    """sum over (J, scale) pairs of _gram(J, scale), as a single BLAS product."""
+    G, _, n = pairs[0][0].shape
+    k = sum(J.shape[1] for J, _ in pairs)
+    A = np.empty((G, k, n), dtype=np.result_type(*(x for p in pairs for x in p)))
+    i = 0
+    for J, scale in pairs:
+        np.multiply(J, scale[:, :, None], out=A[:, i:i + J.shape[1]])
+        i += J.shape[1]
+    A = A.reshape(G * k, n)
+    return A.T @ A
+
+
+def _jt_v(J: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """sum_g J_g^T v_g for J (G, k, n), v (G, k): one matrix-vector product."""
+    return v.reshape(-1) @ J.reshape(-1, J.shape[2])
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise a x b for (G, 3) arrays (np.cross has a large fixed cost at this size)."""
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape), dtype=np.result_type(a, b))
+    a0, a1, a2 = a[:, 0], a[:, 1], a[:, 2]
+    b0, b1, b2 = b[:, 0], b[:, 1], b[:, 2]
+    out[:, 0] = a1 * b2 - a2 * b1
+    out[:, 1] = a2 * b0 - a0 * b2
+    out[:, 2] = a0 * b1 - a1 * b0
+    return out
+
+
 class Effect:
     """Base class: ``needs`` lists kinematic quantities this effect reads."""
 
@@ -62,14 +91,15 @@ class Inertia(Effect):
         sec = ctx.el.section
         kin, wl = ctx.kin, ctx.wl
         Jd = sec.J
+        J_r, J_w = kin.J_r, kin.J_w
         if M is not None:
-            M += _gram(kin.J_r, np.sqrt(wl * sec.rhoA)[:, None])
-            M += _gram(kin.J_w, np.sqrt(wl[:, None] * Jd))
+            M += _gram_stacked([(J_r, np.sqrt(wl * sec.rhoA)[:, None].repeat(3, axis=1)),
+                                (J_w, np.sqrt(wl[:, None] * Jd))])
         if ctx.conv is not None:
-            omega = np.einsum("gin,n->gi", kin.J_w, ctx.qde)
-            rot = Jd * ctx.conv["w_dot"] + np.cross(omega, Jd * omega)
-            F -= np.einsum("g,gin,gi->n", wl * sec.rhoA, kin.J_r, ctx.conv["a"])
-            F -= np.einsum("g,gin,gi->n", wl, kin.J_w, rot)
+            omega = J_w @ ctx.qde
+            rot = Jd * ctx.conv["w_dot"] + _cross(omega, Jd * omega)
+            F -= _jt_v(J_r, (wl * sec.rhoA)[:, None] * ctx.conv["a"])
+            F -= _jt_v(J_w, wl[:, None] * rot)
 
 
 class Elasticity(Effect):
@@ -84,9 +114,10 @@ class Elasticity(Effect):
     def element_terms(self, ctx, M, F):
         el, kin, wl = ctx.el, ctx.kin, ctx.wl
         D = el.section.D
-        sigma = kin.sec.eps * D
-        F -= np.einsum("g,gin,gi->n", wl, kin.B_xi, sigma)
-        W = 0.5 * np.einsum("gi,gi->g", sigma, kin.sec.eps)
+        eps = kin.sec.eps
+        sigma = eps * D
+        F -= _jt_v(kin.B_xi, wl[:, None] * sigma)
+        W = 0.5 * np.einsum("gi,gi->g", sigma, eps)
         total = np.dot(el.q_w, W)            # dU/dl at fixed xi
         inv = 1.0 / (el.n - 1)
         F[el.i_s1] += total * inv     # dl/ds_1 = -1/(n-1), with the minus of F -= ...
@@ -114,10 +145,10 @@ class StressFilter(Effect):
         B = ctx.kin.B_s
         h = self.h
         if M is not None:
-            M += (h * h / 6.0) * _gram(B, np.sqrt(ctx.wl[:, None] * D))
-        eps_dot = np.einsum("gin,n->gi", B, ctx.qde)
+            M += _gram(B, np.sqrt((h * h / 6.0) * ctx.wl[:, None] * D))
+        eps_dot = B @ ctx.qde
         extra = D * (0.5 * h * eps_dot + (h * h / 6.0) * ctx.conv["eps_ddot"])
-        F -= np.einsum("g,gin,gi->n", ctx.wl, B, extra)
+        F -= _jt_v(B, ctx.wl[:, None] * extra)
 
 
 class Gravity(Effect):
@@ -129,7 +160,7 @@ class Gravity(Effect):
         self.g = np.asarray(g, dtype=float)
 
     def element_terms(self, ctx, M, F):
-        F += np.einsum("g,gin,i->n", ctx.wl * ctx.el.section.rhoA, ctx.kin.J_r, self.g)
+        F += _jt_v(ctx.kin.J_r, (ctx.wl * ctx.el.section.rhoA)[:, None] * self.g)
 
 
 @dataclass

@@ -73,52 +73,62 @@ def section_state(rp: np.ndarray, rpp: np.ndarray, gam: np.ndarray, gamp: np.nda
     """Strains, frames and derivatives from r' (G,3), r'' (G,3), gamma (G,), gamma' (G,).
 
     ``basis`` is the reference basis G (3x3, columns g1, g2, g3 in global components).
+
+    With w = G^T r', v = G^T r'' (reference-basis components), a = w2^2 + w3^2, rho = sqrt(a),
+    |w| = sqrt(w1^2 + a):
+        alpha = atan2(-w2, w3), beta = atan(w1 / rho)                         (Eqs. 26-27)
+        grad alpha = (0, -w3, w2) / a,  grad beta = (rho, -w1 w2/rho, -w1 w3/rho) / |w|^2
+        alpha' = grad alpha . v,  beta' = grad beta . v
+    and the curvatures of Eq. 33.  The Hessian-vector products d(alpha')/dw = H_alpha v and
+    d(beta')/dw = H_beta v are written out (no (G, 3, 3) Hessians are formed).
     """
     w = rp @ basis           # components of r' in the reference basis
-    w2v = rpp @ basis        # components of r''
+    v = rpp @ basis          # components of r''
     w1, w2, w3 = w[:, 0], w[:, 1], w[:, 2]
+    v1, v2, v3 = v[:, 0], v[:, 1], v[:, 2]
     a = w2 * w2 + w3 * w3
     rho = np.sqrt(a)
     n2 = w1 * w1 + a
     nrm = np.sqrt(n2)
+    ia = 1.0 / a
+    irho = rho * ia
+    in2 = 1.0 / n2
 
-    alpha = _atan2(-w2, w3)                       # Eq. 26
-    beta = np.arctan(w1 / rho)                    # Eq. 27 (arcsin(w1/|w|), same angle)
+    alpha = 2.0 * np.arctan(-w2 / (rho + w3))     # Eq. 26, _atan2(-w2, w3)
+    beta = np.arctan(w1 * irho)                   # Eq. 27 (arcsin(w1/|w|), same angle)
     sb, cb = w1 / nrm, rho / nrm
+    ca, sa = w3 * irho, -w2 * irho                # cos, sin of alpha
     cg, sg = np.cos(gam), np.sin(gam)
 
     G = w.shape[0]
     dt = w.dtype
-    # gradients of alpha, beta w.r.t. w
-    ga = np.zeros((G, 3), dtype=dt)
-    ga[:, 1] = -w3 / a
-    ga[:, 2] = w2 / a
-    vb = np.stack([rho, -w1 * w2 / rho, -w1 * w3 / rho], axis=1)
-    gb = vb / n2[:, None]
-    # Hessians
-    ha = np.zeros((G, 3, 3), dtype=dt)
-    a2 = a * a
-    ha[:, 1, 1] = 2.0 * w2 * w3 / a2
-    ha[:, 1, 2] = ha[:, 2, 1] = (w3 * w3 - w2 * w2) / a2
-    ha[:, 2, 2] = -2.0 * w2 * w3 / a2
-    dvb = np.zeros((G, 3, 3), dtype=dt)
-    rho3 = rho ** 3
-    dvb[:, 0, 1] = w2 / rho
-    dvb[:, 0, 2] = w3 / rho
-    dvb[:, 1, 0] = -w2 / rho
-    dvb[:, 1, 1] = -w1 / rho + w1 * w2 * w2 / rho3
-    dvb[:, 1, 2] = w1 * w2 * w3 / rho3
-    dvb[:, 2, 0] = -w3 / rho
-    dvb[:, 2, 1] = w1 * w2 * w3 / rho3
-    dvb[:, 2, 2] = -w1 / rho + w1 * w3 * w3 / rho3
-    hb = dvb / n2[:, None, None] - 2.0 * vb[:, :, None] * w[:, None, :] / (n2 * n2)[:, None, None]
-
-    ap = np.einsum("gi,gi->g", ga, w2v)        # alpha'
-    bp = np.einsum("gi,gi->g", gb, w2v)        # beta'
-    dap_dw = np.einsum("gij,gj->gi", ha, w2v)
-    dbp_dw = np.einsum("gij,gj->gi", hb, w2v)
-    dsb_dw = cb[:, None] * gb
-    dcb_dw = -sb[:, None] * gb
+    # gradients of alpha, beta w.r.t. w: g_ab[:, 0] = grad alpha, g_ab[:, 1] = grad beta
+    #   grad alpha = (0, -w3, w2) / a,  grad beta = (e1 - c w) / rho,  c = w1 / |w|^2
+    c = w1 * in2
+    g_ab = np.empty((G, 2, 3), dtype=dt)
+    ga, gb = g_ab[:, 0], g_ab[:, 1]
+    ga[:, 0] = 0.0
+    ga[:, 1] = -w3 * ia
+    ga[:, 2] = w2 * ia
+    np.multiply(w, (-c * irho)[:, None], out=gb)
+    gb[:, 0] = rho * in2
+    q23 = w2 * v2 + w3 * v3
+    u = w1 * v1 + q23                             # w . v
+    ap = (w2 * v3 - w3 * v2) * ia                 # alpha'
+    bp = (a * v1 - w1 * q23) * (irho * in2)       # beta'
+    # Hessian-vector products d(alpha')/dw = H_alpha v, d(beta')/dw = H_beta v:
+    #   d alpha'/dw = ((0, v3, -v2) - 2 alpha' (0, w2, w3)) / a
+    #   d beta'/dw  = k1 w + k2 v + k3 e1
+    t2 = (ap + ap) * ia
+    dap = np.empty((G, 3), dtype=dt)
+    dap[:, 0] = 0.0
+    dap[:, 1] = v3 * ia - t2 * w2
+    dap[:, 2] = -(v2 * ia + t2 * w3)
+    uin = u * in2 * irho
+    bia = bp * ia
+    dbp = w * (2.0 * c * uin - bia)[:, None]
+    dbp += v * (-c * irho)[:, None]
+    dbp[:, 0] += bia * w1 - uin
 
     # strains: eps_s = |r'| - 1, curvatures by Eq. 33
     eps = np.empty((G, 4), dtype=dt)
@@ -127,24 +137,30 @@ def section_state(rp: np.ndarray, rpp: np.ndarray, gam: np.ndarray, gamp: np.nda
     eps[:, 2] = cb * cg * ap + sg * bp
     eps[:, 3] = -cb * sg * ap + cg * bp
 
-    d = np.zeros((G, 4, 8), dtype=dt)
-    # w.r.t. w (converted to r' below), w'' (to r''), gamma, gamma'
-    dw = np.zeros((G, 4, 3), dtype=dt)
-    dww = np.zeros((G, 4, 3), dtype=dt)
-    dw[:, 0] = w / nrm[:, None]
-    dw[:, 1] = dsb_dw * ap[:, None] + sb[:, None] * dap_dw
-    dww[:, 1] = sb[:, None] * ga
-    dw[:, 2] = cg[:, None] * (dcb_dw * ap[:, None] + cb[:, None] * dap_dw) + sg[:, None] * dbp_dw
-    dww[:, 2] = (cb * cg)[:, None] * ga + sg[:, None] * gb
-    dw[:, 3] = -sg[:, None] * (dcb_dw * ap[:, None] + cb[:, None] * dap_dw) + cg[:, None] * dbp_dw
-    dww[:, 3] = -(cb * sg)[:, None] * ga + cg[:, None] * gb
-    d[:, :, 0:3] = dw @ basis.T
-    d[:, :, 3:6] = dww @ basis.T
-    d[:, 2, 6] = -cb * sg * ap + cg * bp
-    d[:, 3, 6] = -cb * cg * ap - sg * bp
+    # derivatives w.r.t. (w, v) in the reference basis, rows eps_s, kappa_s, kappa_t, kappa_b
+    dref = np.empty((G, 4, 2, 3), dtype=dt)
+    dref[:, 0, 0] = w * (1.0 / nrm)[:, None]
+    dref[:, 0, 1] = 0.0
+    dref[:, 1, 0] = (cb * ap)[:, None] * gb + sb[:, None] * dap
+    dref[:, 1, 1] = sb[:, None] * ga
+    p1 = np.empty((G, 2, 3), dtype=dt)            # (d/dw, d/dv) of cb alpha'
+    p1[:, 0] = cb[:, None] * dap - (sb * ap)[:, None] * gb
+    p1[:, 1] = cb[:, None] * ga
+    p2 = np.empty((G, 2, 3), dtype=dt)            # (d/dw, d/dv) of beta'
+    p2[:, 0] = dbp
+    p2[:, 1] = gb
+    cg3, sg3 = cg[:, None, None], sg[:, None, None]
+    dref[:, 2] = cg3 * p1 + sg3 * p2
+    dref[:, 3] = cg3 * p2 - sg3 * p1
+    d = np.empty((G, 4, 8), dtype=dt)
+    d[:, :, 0:6] = (dref.reshape(8 * G, 3) @ basis.T).reshape(G, 4, 6)
+    d[:, 0:2, 6] = 0.0
+    d[:, 2, 6] = eps[:, 3]                        # d kappa_t / d gamma = kappa_b
+    d[:, 3, 6] = -eps[:, 2]
+    d[:, :, 7] = 0.0
     d[:, 1, 7] = 1.0
 
-    dpsi = np.stack([ga @ basis.T, gb @ basis.T], axis=1)
+    dpsi = (g_ab.reshape(2 * G, 3) @ basis.T).reshape(G, 2, 3)
 
     tmat = np.zeros((G, 3, 3), dtype=dt)           # Eq. 31
     tmat[:, 0, 0] = sb
@@ -154,7 +170,26 @@ def section_state(rp: np.ndarray, rpp: np.ndarray, gam: np.ndarray, gamp: np.nda
     tmat[:, 2, 0] = -cb * sg
     tmat[:, 2, 1] = cg
 
-    frame = cardan_frame(alpha, beta, gam) @ basis.T
-    angles = np.stack([alpha, beta, gam], axis=1)
-    psi_prime = np.stack([ap, bp, gamp], axis=1)
+    # Cardan frame (Eq. 24) from the direction cosines already at hand: rows e_t, e_b, e_s with
+    # e_t = cg u1 + sg u2, e_b = -sg u1 + cg u2, u1 = (cb, sa sb, -ca sb), u2 = (0, ca, sa)
+    fref = np.empty((G, 3, 3), dtype=dt)
+    u1x, u1y, u1z = cb, sa * sb, -ca * sb
+    fref[:, 0, 0] = cg * u1x
+    fref[:, 0, 1] = cg * u1y + sg * ca
+    fref[:, 0, 2] = cg * u1z + sg * sa
+    fref[:, 1, 0] = -sg * u1x
+    fref[:, 1, 1] = cg * ca - sg * u1y
+    fref[:, 1, 2] = cg * sa - sg * u1z
+    fref[:, 2, 0] = sb
+    fref[:, 2, 1] = -sa * cb
+    fref[:, 2, 2] = ca * cb
+    frame = (fref.reshape(3 * G, 3) @ basis.T).reshape(G, 3, 3)
+    angles = np.empty((G, 3), dtype=np.result_type(alpha, gam))
+    angles[:, 0] = alpha
+    angles[:, 1] = beta
+    angles[:, 2] = gam
+    psi_prime = np.empty((G, 3), dtype=np.result_type(ap, gamp))
+    psi_prime[:, 0] = ap
+    psi_prime[:, 1] = bp
+    psi_prime[:, 2] = gamp
     return SectionState(eps, d, angles, dpsi, tmat, frame, psi_prime)

@@ -92,6 +92,64 @@ class PointKinematics:
     J_psi: np.ndarray | None = None   # (G, 3, nq) Cardan angles (alpha, beta, gamma) at fixed s
 
 
+class _LazyState:
+    """What evaluate() keeps to form the remaining PointKinematics fields on demand."""
+
+    __slots__ = ("el", "X", "Y", "RR", "TT", "ds_dchi", "strains", "material", "dt", "coef",
+                 "S6")
+
+    def __init__(self, el, X, Y, RR, TT, ds_dchi, strains, material, dt):
+        self.el, self.X, self.Y, self.RR, self.TT = el, X, Y, RR, TT
+        self.ds_dchi, self.strains, self.material, self.dt = ds_dchi, strains, material, dt
+        self.coef = self.S6 = None
+
+
+class _LazyKinematics(PointKinematics):
+    """The PointKinematics returned by SplineElement.evaluate.
+
+    A PointKinematics (same fields, same values) whose ``sec``, ``J_r``, ``J_w``, ``B_xi``,
+    ``B_s`` and ``J_psi`` are formed on first access and then kept: a point load reads J_r only,
+    the complex-step pass of the model J_r, J_w, B_s only, and none of them needs the Cardan-angle
+    Jacobian J_psi.  Assigning a field replaces it as for the plain dataclass.
+    """
+
+    def _form(self, name):
+        st = self.__dict__["_lazy"]
+        el = st.el
+        if name == "sec":
+            value = el._kin_sec(st)
+        elif (name == "B_xi" and not st.strains) or (name == "B_s" and not st.material):
+            value = None
+        elif name == "B_s" and "_f_B_xi" in self.__dict__:
+            value = el._kin_B(st, self.sec, B_xi=self.__dict__["_f_B_xi"])
+        else:
+            value = el._kin_J_r(st) if name == "J_r" else getattr(el, "_kin_" + name)(st, self.sec)
+        if value is not None and name != "sec" and value.dtype != st.dt:
+            value = value.astype(st.dt)   # complex s with real qe: Jacobians are real
+        self.__dict__["_f_" + name] = value
+        return value
+
+
+def _lazy_field(name):
+    key = "_f_" + name
+
+    def get(self):
+        try:
+            return self.__dict__[key]
+        except KeyError:
+            return self._form(name)
+
+    def set(self, value):
+        self.__dict__[key] = value
+
+    return property(get, set, doc=f"{name} (formed on first access)")
+
+
+for _name in ("sec", "J_r", "J_w", "B_xi", "B_s", "J_psi"):
+    setattr(_LazyKinematics, _name, _lazy_field(_name))
+del _name
+
+
 class SplineElement:
     """One moving-node spline element (Section 4) with ``n_nodes`` nodes.
 
@@ -124,6 +182,7 @@ class SplineElement:
         self.q_sub = np.repeat(np.arange(n - 1), len(xg))
         self.q_xi = np.tile(xg, n - 1)
         self.q_w = np.tile(wg, n - 1)
+        self._basis_tables()
 
     # -- coordinate helpers -------------------------------------------------------------
     def index(self, what: str, node: int = 0, comp: int = 0) -> int:
@@ -164,6 +223,86 @@ class SplineElement:
         return np.clip(np.floor((np.asarray(s) - s1) / ell).astype(int), 0, self.n - 2)
 
     # -- kinematics --------------------------------------------------------------------
+    #
+    # Implementation (performance, benchmarks/README.md).  For every point the element needs
+    # the basis rows
+    #     position  X = [phi_k l^(p-k), k = 0..3]   (r and its first three s-derivatives)
+    #               and the l-derivatives (p - k) phi_k l^(p-k-1), k = 0..2, at fixed xi
+    #     torsion   Y = [psi_k l^(t-k), k = 0..2] and the l-derivatives of the first two
+    # (phi_k, psi_k = d^k/dxi^k of the scaled bases, p, t the powers of l of the coefficients),
+    # so one matrix product with the coefficients gives all centre-line and torsion quantities.
+    # At the default quadrature points phi_k, psi_k are constant and cached; elsewhere they are
+    # sum_p xi^p D[sub, p] with a cached table D.  The Jacobians are formed on first access of
+    # the returned PointKinematics (_LazyKinematics, _kin_* below).
+
+    def _basis_tables(self) -> None:
+        """Constant tables of the element (they depend only on n and the Gauss rule)."""
+        b = self.basis
+        n = self.n
+        self._tables_key = (self.q_xi, self.q_sub)
+        # exponents/factors of l for the 7 position rows and the 5 torsion rows
+        kp = np.array([0, 1, 2, 3, 0, 1, 2])
+        dp = np.array([0, 0, 0, 0, 1, 1, 1])
+        self._exp_p = b.pos_powers[None, :] - kp[:, None] - dp[:, None]
+        self._fac_p = np.where(dp[:, None] == 1, b.pos_powers[None, :] - kp[:, None], 1.0)
+        kt = np.array([0, 1, 2, 0, 1])
+        dtt = np.array([0, 0, 0, 1, 1])
+        self._exp_t = b.tor_powers[None, :] - kt[:, None] - dtt[:, None]
+        self._fac_t = np.where(dtt[:, None] == 1, b.tor_powers[None, :] - kt[:, None], 1.0)
+        # l**e for the integer exponents e in [-4, 2] come from a 7-entry table
+        self._pow_p = (self._exp_p + 4).astype(int)
+        self._pow_t = (self._exp_t + 4).astype(int)
+        # at the default quadrature points
+        xi, sub = self.q_xi, self.q_sub
+        C, Ct = b.pos_coeffs[sub], b.tor_coeffs[sub]
+        phi = np.stack([np.einsum("gm,gma->ga", xi_powers(xi, k, 5), C) for k in range(4)], 1)
+        psi = np.stack([np.einsum("gm,gma->ga", xi_powers(xi, k, 3), Ct) for k in range(3)], 1)
+        self._q_phi = phi[:, kp] * self._fac_p                   # (G, 7, n+4), factors folded in
+        self._q_psi = psi[:, kt] * self._fac_t                   # (G, 5, 2n)
+        self._q_pos = sub + xi
+        frac = self._q_pos * (1.0 / (n - 1))
+        self._q_ds_dchi = np.stack([1.0 - frac, frac], axis=1)
+        # arbitrary points: all basis rows of a point are sum_p xi^p D[sub, p, :]
+        fac = np.zeros((6, 4, 6))                  # d^k/dxi^k xi^m = fac[p, k, m] xi^p
+        for k in range(4):
+            for m in range(k, 6):
+                fac[m - k, k, m] = np.prod(np.arange(m - k + 1, m + 1, dtype=float))
+        Dp = np.einsum("pkm,ima->ipka", fac, b.pos_coeffs)[:, :, kp] * self._fac_p
+        Dt = np.einsum("pkm,ima->ipka", fac[:4, :3, :4], b.tor_coeffs)[:, :, kt] * self._fac_t
+        Dt = np.concatenate([Dt, np.zeros((n - 1, 2) + Dt.shape[2:])], axis=1)
+        self._D_all = np.concatenate([Dp.reshape(n - 1, 6, -1), Dt.reshape(n - 1, 6, -1)], 2)
+        inv = 1.0 / (n - 1)
+        self._dl_dchi = np.array([-inv, inv])
+
+    def _basis_at(self, xi: np.ndarray, sub: np.ndarray):
+        """Position rows (G, 7, n+4) and torsion rows (G, 5, 2n) at arbitrary (complex) xi
+        (with the factors _fac_p, _fac_t applied, as the cached _q_phi, _q_psi)."""
+        n, G = self.n, len(xi)
+        pw = np.empty((G, 6), dtype=np.result_type(xi, float))
+        pw[:, 0] = 1.0
+        pw[:, 1] = xi
+        for p in range(2, 6):
+            pw[:, p] = pw[:, p - 1] * xi
+        cplx = np.iscomplexobj(pw)
+        if G == 1:
+            D = self._D_all[sub[0]]
+            rows = (pw.real @ D + 1j * (pw.imag @ D)) if cplx else pw @ D
+        elif G == len(self.q_sub) and (sub is self.q_sub or np.array_equal(sub, self.q_sub)):
+            # the quadrature layout: points grouped by sub-element, one batched product
+            ng = G // (n - 1)
+            pw3 = pw.reshape(n - 1, ng, 6)
+            if cplx:
+                rows = np.empty((n - 1, ng, self._D_all.shape[2]), dtype=pw.dtype)
+                rows.real = pw3.real @ self._D_all
+                rows.imag = pw3.imag @ self._D_all
+            else:
+                rows = pw3 @ self._D_all
+            rows = rows.reshape(G, -1)
+        else:
+            rows = np.einsum("gp,gpx->gx", pw, self._D_all[sub])
+        npb = 7 * (n + 4)
+        return rows[:, :npb].reshape(G, 7, n + 4), rows[:, npb:].reshape(G, 5, 2 * n)
+
     def evaluate(self, qe: np.ndarray, s: np.ndarray | None = None,
                  sub: np.ndarray | None = None, strains: bool = True,
                  material_strain: bool = False) -> PointKinematics:
@@ -171,99 +310,152 @@ class SplineElement:
 
         Complex ``qe`` is allowed (complex-step); then pass the real ``s`` and ``sub`` of the
         real evaluation so that the same material points are followed.
+
+        s, sub, ell, r, rp are computed here; the section state and the Jacobians (sec, J_r,
+        J_w, B_xi, B_s, J_psi) on first access of the returned object (same values, nothing is
+        formed that the caller does not read; they do not depend on ``qe`` being kept unchanged).
         """
-        n, b = self.n, self.basis
-        P = qe[:3 * (n + 4)].reshape(n + 4, 3)
+        n = self.n
+        if self._tables_key[0] is not self.q_xi or self._tables_key[1] is not self.q_sub:
+            self._basis_tables()
+        na = n + 4
+        npos = 3 * na
+        P = qe[:npos].reshape(na, 3)
         gv = qe[self.tor_slice]
         s1, sn = qe[self.i_s1], qe[self.i_sn]
         ell = (sn - s1) / (n - 1)                                     # Eq. 5
         if s is None:
             sub = self.q_sub
-            xi = self.q_xi.astype(np.result_type(ell, float))
-            s = (s1 + (sub + self.q_xi) * ell).real
+            s = (s1 + self._q_pos * ell).real
+            phi, psi = self._q_phi, self._q_psi
+            ds_dchi = self._q_ds_dchi
         else:
             s = np.atleast_1d(np.asarray(s))          # complex allowed (complex-step in s)
             sub = self.locate(qe, s.real) if sub is None else np.atleast_1d(sub)
             xi = (s - s1) / ell - sub                                  # Eq. 10
+            phi, psi = self._basis_at(xi, sub)
+            frac = (sub + xi) * (1.0 / (n - 1))
+            ds_dchi = np.empty((len(s), 2), dtype=frac.dtype)          # ds/d(s_1, s_n) at fixed xi
+            ds_dchi[:, 1] = frac
+            ds_dchi[:, 0] = 1.0 - frac
         Gn = len(s)
-        dt = np.result_type(qe, float)
 
-        C = b.pos_coeffs[sub]                                          # (G, 6, n+4)
-        lp = ell ** b.pos_powers
-        dlp = b.pos_powers * ell ** np.maximum(b.pos_powers - 1, 0)
-        phi = [np.einsum("gm,gma->ga", xi_powers(xi, k, 5), C) for k in range(4)]
-        Phi = [p * lp for p in phi]
-        R = [Ph @ P for Ph in Phi]
-        dR = [(p * dlp) @ P for p in phi[:3]]
-        r = R[0]
-        rp = R[1] / ell
-        rpp = R[2] / ell ** 2
-        rppp = R[3] / ell ** 3
-        dr_dl = dR[0]
-        drp_dl = dR[1] / ell - R[1] / ell ** 2
-        drpp_dl = dR[2] / ell ** 2 - 2.0 * R[2] / ell ** 3
+        # basis rows with the powers of l, and all centre-line / torsion quantities at once
+        il = 1.0 / ell
+        il2 = il * il
+        lpow = np.array([il2 * il2, il2 * il, il2, il, 1.0, ell, ell * ell])  # l**(-4..2)
+        X = phi * lpow[self._pow_p]                                    # (G, 7, n+4)
+        Y = psi * lpow[self._pow_t]                                    # (G, 5, 2n)
+        # RR: r and its s-derivatives of order 1..3, then d/dl (at fixed xi) of orders 0..2;
+        # TT: gamma and its s-derivatives of order 1, 2, then d/dl of orders 0, 1
+        RR = (X.reshape(7 * Gn, na) @ P).reshape(Gn, 7, 3).transpose(1, 0, 2).copy()
+        TT = (Y.reshape(5 * Gn, 2 * n) @ gv).reshape(Gn, 5).T.copy()
+        kin = _LazyKinematics.__new__(_LazyKinematics)
+        kin.__dict__.update(s=s, sub=np.asarray(sub), ell=ell, r=RR[0], rp=RR[1], _lazy=_LazyState(
+            self, X, Y, RR, TT, ds_dchi, bool(strains), bool(strains and material_strain),
+            np.result_type(qe, float)))
+        return kin
 
-        Ct = b.tor_coeffs[sub]                                         # (G, 4, 2n)
-        lt = ell ** b.tor_powers
-        dlt = b.tor_powers * ell ** np.maximum(b.tor_powers - 1, 0)
-        psi = [np.einsum("gm,gma->ga", xi_powers(xi, k, 3), Ct) for k in range(3)]
-        Psi = [p * lt for p in psi]
-        gam = Psi[0] @ gv
-        gamp = Psi[1] @ gv / ell
-        gampp = Psi[2] @ gv / ell ** 2
-        dgam_dl = (psi[0] * dlt) @ gv
-        dgamp_dl = (psi[1] * dlt) @ gv / ell - gamp / ell
+    # -- the lazily formed parts of evaluate() (see _LazyKinematics) ----------------------
+    #
+    # Every Jacobian has the column blocks [positions 3(n+4) | torsion 2n | s_1, s_n].  Its
+    # position block is a Kronecker product: row i, column 3a + j is sum_k c_k[g, i, j] X_k[g, a]
+    # (c_k = derivative of the quantity w.r.t. r' or r'' for k = 1, 2; the identity for r, k = 0),
+    # formed as [c_1 c_2] @ S6 with the interleaved rows S6 = [X_1 (x) I3; X_2 (x) I3] shared by
+    # all Jacobians of a point set; no dense Jacobians of r', r'' are formed and contracted.  The
+    # material-coordinate block is c_l dl/dchi + c_s ds/dchi with two coefficients per row.
 
-        inv = 1.0 / (n - 1)
-        dl_dchi = np.array([-inv, inv])                                # dl/d(s_1, s_n)
-        frac = (sub + xi) * inv
-        ds_dchi = np.stack([1.0 - frac, frac], axis=1)                 # ds/d(s_1, s_n) at fixed xi
+    def _kin_sec(self, st: "_LazyState") -> SectionState:
+        return section_state(st.RR[1], st.RR[2], st.TT[0], st.TT[1], self.G)
 
-        nq = self.n_coords
-        npos = 3 * (n + 4)
-        eye3 = np.eye(3)
-        chi = slice(self.i_s1, self.i_sn + 1)
+    def _kron_rows(self, st: "_LazyState") -> np.ndarray:
+        """S6 (G, 6, 3(n+4)): rows X_1 (x) e_j and X_2 (x) e_j (j = 0..2) of the position block.
 
-        def pos_block(Ph):
-            return (Ph[:, None, :, None] * eye3[None, :, None, :]).reshape(Gn, 3, npos)
+        A position block with rows c1[:, i, :] . dr'/dQ + c2[:, i, :] . dr''/dQ is then the batched
+        product [c1 c2] @ S6 (one BLAS call per point instead of dense (G, 3, nq) Jacobians of r'
+        and r'' and their contraction)."""
+        if st.S6 is None:
+            X = st.X
+            npos = 3 * (self.n + 4)
+            S6 = np.zeros((X.shape[0], 6, npos), dtype=X.dtype)
+            for j in range(3):
+                S6[:, j, j::3] = X[:, 1]
+                S6[:, 3 + j, j::3] = X[:, 2]
+            st.S6 = S6
+        return st.S6
 
-        J_r = np.zeros((Gn, 3, nq), dtype=dt)
-        J_r[:, :, :npos] = pos_block(Phi[0])
-        J_r[:, :, chi] = dr_dl[:, :, None] * dl_dchi - rp[:, :, None] * ds_dchi[:, None, :]
+    def _kin_J_r(self, st: "_LazyState") -> np.ndarray:
+        """J_r = dr/dQ|_s: position block X_0 (x) I3, material block dr/dl dl/dchi - r' ds/dchi."""
+        npos = 3 * (self.n + 4)
+        X, RR = st.X, st.RR
+        J_r = np.zeros((X.shape[0], 3, self.n_coords), dtype=np.result_type(X, RR))
+        for j in range(3):
+            J_r[:, j, j:npos:3] = X[:, 0]
+        J_r[:, :, self.i_s1:] = (RR[4][:, :, None] * self._dl_dchi
+                                 - RR[1][:, :, None] * st.ds_dchi[:, None, :])
+        return J_r
 
-        J_rp = np.zeros((Gn, 3, nq), dtype=dt)
-        J_rp[:, :, :npos] = pos_block(Phi[1] / ell)
-        J_rp[:, :, chi] = drp_dl[:, :, None] * dl_dchi - rpp[:, :, None] * ds_dchi[:, None, :]
-        J_g = np.zeros((Gn, nq), dtype=dt)
-        J_g[:, self.tor_slice] = Psi[0]
-        J_g[:, chi] = dgam_dl[:, None] * dl_dchi - gamp[:, None] * ds_dchi
+    def _psi_coef(self, st, sec):
+        """Material-coordinate columns (G, 3, 2) of the Cardan-angle Jacobian at fixed s."""
+        if st.coef is None:
+            RR, TT = st.RR, st.TT
+            # d(alpha, beta)/dl at fixed xi and (alpha, beta)' from dr'/dl and r''
+            cab = sec.dpsi_drp @ RR[[5, 2]].transpose(1, 2, 0)         # (G, 2, 2)
+            chi = np.empty((cab.shape[0], 3, 2), dtype=np.result_type(cab, st.ds_dchi))
+            chi[:, 0:2] = (cab[:, :, 0:1] * self._dl_dchi
+                           - cab[:, :, 1:2] * st.ds_dchi[:, None, :])
+            chi[:, 2] = TT[3][:, None] * self._dl_dchi - TT[1][:, None] * st.ds_dchi
+            st.coef = chi
+        return st.coef
 
-        sec = section_state(rp, rpp, gam, gamp, self.G)
+    def _kin_J_psi(self, st: "_LazyState", sec: SectionState) -> np.ndarray:
+        """Cardan angles at fixed s: (alpha, beta) from r', gamma."""
+        npos = 3 * (self.n + 4)
+        chi = self._psi_coef(st, sec)
+        J = np.zeros((st.X.shape[0], 3, self.n_coords), dtype=chi.dtype)
+        np.matmul(sec.dpsi_drp, self._kron_rows(st)[:, 0:3], out=J[:, 0:2, :npos])
+        J[:, 2, npos:self.i_s1] = st.Y[:, 0]
+        J[:, :, self.i_s1:] = chi
+        return J
 
-        # material angular velocity Jacobian (Eqs. 30-31): omega = T (alpha, beta, gamma)^.
-        dpsi = np.empty((Gn, 3, nq), dtype=dt)
-        dpsi[:, 0:2] = np.einsum("gki,gin->gkn", sec.dpsi_drp, J_rp)
-        dpsi[:, 2] = J_g
-        J_w = np.einsum("gij,gjn->gin", sec.tmat, dpsi)
+    def _kin_J_w(self, st: "_LazyState", sec: SectionState) -> np.ndarray:
+        """Material angular velocity Jacobian (Eqs. 30-31): omega = T (alpha, beta, gamma)^."""
+        npos = 3 * (self.n + 4)
+        chi = self._psi_coef(st, sec)
+        tmat = sec.tmat
+        A = tmat[:, :, 0:2] @ sec.dpsi_drp                             # d omega / d r'
+        J = np.empty((st.X.shape[0], 3, self.n_coords), dtype=np.result_type(chi, st.X))
+        np.matmul(A, self._kron_rows(st)[:, 0:3], out=J[:, :, :npos])
+        np.multiply(tmat[:, :, 2, None], st.Y[:, None, 0], out=J[:, :, npos:self.i_s1])
+        J[:, :, self.i_s1:] = tmat @ chi
+        return J
 
-        B_xi = B_s = None
-        if strains:
-            J_x = np.zeros((Gn, 8, nq), dtype=dt)                      # x = (r', r'', g, g')
-            J_x[:, 0:3, :npos] = pos_block(Phi[1] / ell)
-            J_x[:, 0:3, chi] = drp_dl[:, :, None] * dl_dchi
-            J_x[:, 3:6, :npos] = pos_block(Phi[2] / ell ** 2)
-            J_x[:, 3:6, chi] = drpp_dl[:, :, None] * dl_dchi
-            J_x[:, 6, self.tor_slice] = Psi[0]
-            J_x[:, 6, chi] = dgam_dl[:, None] * dl_dchi
-            J_x[:, 7, self.tor_slice] = Psi[1] / ell
-            J_x[:, 7, chi] = dgamp_dl[:, None] * dl_dchi
-            B_xi = np.einsum("gij,gjn->gin", sec.deps_dx, J_x)
-            if material_strain:
-                xprime = np.concatenate([rpp, rppp, gamp[:, None], gampp[:, None]], axis=1)
-                eps_prime = np.einsum("gij,gj->gi", sec.deps_dx, xprime)
-                B_s = B_xi.copy()
-                B_s[:, :, chi] -= eps_prime[:, :, None] * ds_dchi[:, None, :]
-        return PointKinematics(s, np.asarray(sub), ell, r, rp, sec, J_r, J_w, B_xi, B_s, dpsi)
+    def _kin_B_xi(self, st: "_LazyState", sec: SectionState) -> np.ndarray:
+        return self._kin_B(st, sec, material=False)
+
+    def _kin_B_s(self, st: "_LazyState", sec: SectionState) -> np.ndarray:
+        return self._kin_B(st, sec, material=True)
+
+    def _kin_B(self, st, sec, material=True, B_xi=None):
+        """Strain Jacobian at fixed xi (B_xi) or at fixed s (B_s = B_xi - eps' ds/dchi)."""
+        npos = 3 * (self.n + 4)
+        d = sec.deps_dx                                                # (G, 4, 8)
+        RR, TT = st.RR, st.TT
+        # c_l = d eps/dl at fixed xi = d . x_l with x_l = l-derivatives of (r', r'', gamma,
+        # gamma'); for B_s also eps' = d . x' with x' = s-derivatives of the same
+        x_l = np.concatenate([RR[5], RR[6], TT[3][:, None], TT[4][:, None]], axis=1)
+        chi = (d @ x_l[:, :, None]) * self._dl_dchi
+        if material:
+            x_p = np.concatenate([RR[2], RR[3], TT[1][:, None], TT[2][:, None]], axis=1)
+            chi -= (d @ x_p[:, :, None]) * st.ds_dchi[:, None, :]
+        if B_xi is not None:
+            B = B_xi.copy()
+        else:
+            B = np.empty((st.X.shape[0], 4, self.n_coords), dtype=np.result_type(d, st.X))
+            np.matmul(d[:, :, 0:6], self._kron_rows(st), out=B[:, :, :npos])
+            np.matmul(d[:, :, 6:8], st.Y[:, 0:2], out=B[:, :, npos:self.i_s1])
+        B[:, :, self.i_s1:] = chi
+        return B
 
     def strain_energy_density(self, kin: PointKinematics) -> np.ndarray:
         """W = eps^T D eps / 2 at the points (J/m)."""
