@@ -52,9 +52,10 @@ _H = 1e-20
 def constraint_terms(cons: list[NonlinearConstraint], t: float, Q: Vec, Qd: Vec):
     """Stacked (violation Phi, Jacobian g_Q, velocity violation Phi_dot, b_ddot - g_QQ[Qd,Qd])."""
     phis, jacs, dphis, rhs = [], [], [], []
+    Qc = Q + 1j * _H * Qd                  # one complex state: the point caches serve all rows
     for c in cons:
         g, J = c.evaluate(Q)
-        _, Jc = c.evaluate(Q + 1j * _H * Qd)
+        _, Jc = c.evaluate(Qc)
         quad = (Jc @ Qd).imag / _H
         b, bd, bdd = c.b(t)
         phis.append(np.real(g) - b)
@@ -102,12 +103,27 @@ def material_point(model, ibeam: int, s_fixed: float | None = None, s_index: int
     (e_s, e_t, e_b), e.g. the luffing pivot D1 and cylinder head D3 (Section 9, Fig. 13a):
     r_o = r + o_s e_s + o_t e_t + o_b e_b,  dr_o = dr + delta_phi x o  (delta_phi = frame^T dw).
     """
+    key = (ibeam, None if s_fixed is None else float(s_fixed), s_index,
+           None if offset is None else tuple(float(x) for x in offset))
+    cache = model.__dict__.setdefault("_material_points", {})
+    if key in cache:                       # one function (and one evaluation cache) per point
+        return cache[key]
     o_sec = None if offset is None else np.asarray(offset, float)
     beam = model.beams[ibeam]
     off = int(model.offsets[ibeam])
     N = model.n_coords
 
+    memo: list = []                        # [(Q copy, result)] for the real and complex state
+
     def f(Q):
+        for Qm, res in memo:
+            if Qm.dtype == Q.dtype and Qm.shape == Q.shape and np.array_equal(Qm, Q):
+                return res
+        res = _evaluate(Q)
+        memo[:] = [m for m in memo if m[0].dtype != Q.dtype][:1] + [(Q.copy(), res)]
+        return res
+
+    def _evaluate(Q):
         s = Q[s_index] if s_index is not None else s_fixed
         e = model._element_at(ibeam, Q.real, float(np.real(s)))
         idx = off + beam.index_map[e]
@@ -132,6 +148,7 @@ def material_point(model, ibeam: int, s_fixed: float | None = None, s_index: int
             r = r + o
         return r, J, kin.sec.angles[0], Jp
 
+    cache[key] = f
     return f
 
 
