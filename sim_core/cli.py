@@ -150,7 +150,22 @@ def cmd_describe(args) -> int:
     if scene.get("kind") == "telescopic":
         from .telescopic import build_telescopic
         from .telescopic_scene import params_from_scene
-        model = build_telescopic(params_from_scene(scene)).model
+        params = params_from_scene(scene)
+        if not params.flexible:
+            from .rigid_telescopic import RigidTelescopic
+            rig = RigidTelescopic(params)
+            print(f"scene {scene['name']}: {scene['description']}")
+            print("effects: " + ", ".join(f"{k}={'on' if v else 'off'}"
+                                          for k, v in scene["effects"].items()))
+            print("assembled contributions: rigid booms (kinematic limit)"
+                  + (", elastic ropes" if rig.elastic else ", inextensible rope" if rig.ropes else ""))
+            print(f"coordinates: {rig.n_dof}, DOF: {rig.n_dof}")
+            print(json.dumps({k: v for k, v in scene.items() if k != "source"}, indent=2))
+            return 0
+        ts = build_telescopic(params)
+        model = ts.model
+        if ts.contact is not None and not params.friction:
+            print("note: slider-spring distribution evaluated for the outputs only (friction off)")
     else:
         model, _, _ = build_model(scene)
     print(f"scene {scene['name']}: {scene['description']}")

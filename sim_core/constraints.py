@@ -193,3 +193,23 @@ def distance_driver(name: str, fa, fb, length) -> NonlinearConstraint:
         n = np.sqrt(d @ d)
         return np.atleast_1d(n), ((d / n) @ (Ja - Jb))[None, :]
     return NonlinearConstraint(name, 1, evaluate, length)
+
+
+def rope_length(name: str, points, length: float) -> NonlinearConstraint:
+    """Inextensible rope over frictionless point pulleys: sum |r_{i+1} - r_i| = L0 (m).
+
+    The bilateral limit of :class:`sim_core.point_effects.RopeDrive` (effects.rope_elasticity =
+    false): the rope length fixes the pulley kinematics (boom 3 moves twice the piston stroke,
+    Zhao-Qi-Wang 2024 Eqs. 74-76).  The rope tension is T = -lambda (N); T < 0 means the opposite
+    (retraction) rope carries |T|, which is why one bilateral constraint stands for both ropes."""
+    def evaluate(Q):
+        pts = [p(Q) for p in points]
+        ell = 0.0
+        J = 0.0
+        for (ra, Ja, _, _), (rb, Jb, _, _) in zip(pts[:-1], pts[1:]):
+            d = rb - ra
+            n = np.sqrt(d @ d)
+            ell = ell + n
+            J = J + (d / n) @ (Jb - Ja)
+        return np.atleast_1d(ell), np.atleast_2d(J)
+    return NonlinearConstraint(name, 1, evaluate, _fixed([length]))

@@ -24,6 +24,9 @@ def section_reaction(point, Q, lam_point, lam_angles, basis):
     multipliers (lam_point, lam_angles) exerts on its *second* body b (g = r_a - r_b): -lambda,
     the moment from the Cardan-angle multipliers m = T^-T lambda_psi (Eq. 31)."""
     _, _, psi, _ = point(Q)
+    lam_angles = np.asarray(lam_angles)
+    if lam_angles.shape[0] == 2:          # effects.torsion = false: no gamma row, no twist moment
+        lam_angles = np.array([lam_angles[0], lam_angles[1], 0.0])
     frame = cardan_frame(*psi) @ basis.T                 # rows e_t, e_b, e_s (global)
     sb, cb = np.sin(psi[1]), np.cos(psi[1])
     sg, cg = np.sin(psi[2]), np.cos(psi[2])
@@ -35,13 +38,20 @@ def section_reaction(point, Q, lam_point, lam_angles, basis):
 
 
 class ContactFriction:
-    """Multiplier-dependent friction forces on the contact coordinates of all regions."""
+    """Multiplier-dependent friction forces on the contact coordinates of all regions.
+
+    ``distribution=True`` (effects.contact_distribution): the normal load of a region is the sum
+    of its slider-spring forces from the micro-motion solve (Eqs. 59-71).  ``False``: only the
+    constraint resultant is known; the normal load is the magnitude of its transverse force
+    N = |(f_t, f_b)| (a lower bound of the spring sum: the force couples that carry the contact
+    moment are not seen), and no slider geometry is needed, so any number of booms works."""
 
     name = "friction"
 
     def __init__(self, ts, mu_static: float, mu_dynamic: float, v_eps: float,
-                 k0: float = 1e9, eps: float = 1e-6):
+                 k0: float = 1e9, eps: float = 1e-6, distribution: bool = True):
         self.ts = ts
+        self.distribution = distribution
         self.law = FrictionLaw(mu_static, mu_dynamic, v_eps)
         self.spring = SpringLaw(k0, eps)
         self.basis = ts.model.beams[0].reference_basis
@@ -51,20 +61,24 @@ class ContactFriction:
         for k in range(ts.params.n_booms - 1):
             inner = material_point(m, k, s_index=ts.s2_index[k])
             outer = material_point(m, k + 1, s_index=ts.s3_index[k + 1])
-            self.regions.append((f"I_{k + 1}{k + 2}", inner, ts.s2_index[k],
-                                 SliderGeometry.paper_region(k + 1, "inner")))
-            self.regions.append((f"II_{k + 1}{k + 2}", outer, ts.s3_index[k + 1],
-                                 SliderGeometry.paper_region(k + 1, "outer")))
+            geo = ((SliderGeometry.paper_region(k + 1, "inner"),
+                    SliderGeometry.paper_region(k + 1, "outer")) if distribution else (None, None))
+            self.regions.append((f"I_{k + 1}{k + 2}", inner, ts.s2_index[k], geo[0]))
+            self.regions.append((f"II_{k + 1}{k + 2}", outer, ts.s3_index[k + 1], geo[1]))
         self._x0 = {}
 
     def solve_regions(self, Q, Qd, lam):
-        """Per region: (name, s_index, mu, ContactSolution)."""
+        """Per region: (name, s_index, mu, ContactSolution) (distribution on) or
+        (name, s_index, mu, N) with the transverse resultant N in N (distribution off)."""
         rows = self.ts.rows
         out = []
         for name, point, s_idx, geom in self.regions:
             f_c, m_c = section_reaction(point, Q, lam[rows[name + "_point"]],
                                         lam[rows[name + "_angles"]], self.basis)
             mu = self.law.mu(float(Qd[s_idx]))
+            if geom is None:
+                out.append((name, s_idx, mu, float(np.hypot(f_c[1], f_c[2]))))
+                continue
             sol = solve_micro_motion(geom, self.spring, f_c, m_c, mu, x0=self._x0.get(name))
             self._x0[name] = sol.x
             out.append((name, s_idx, mu, sol))
@@ -73,5 +87,10 @@ class ContactFriction:
     def forces(self, t, Q, Qd, lam):
         dF = np.zeros(len(Q))
         for _, s_idx, mu, sol in self.solve_regions(Q, Qd, lam):
-            dF[s_idx] -= mu * sol.total_normal_force
+            dF[s_idx] -= mu * (sol if geom_free(sol) else sol.total_normal_force)
         return dF
+
+
+def geom_free(sol) -> bool:
+    """True for the resultant-only normal load (a float) of ``solve_regions``."""
+    return isinstance(sol, float)

@@ -107,15 +107,26 @@ def constrained_static_equilibrium(model: Model, z0: np.ndarray, t: float = 0.0,
             d = np.linalg.solve(A, -np.concatenate([r1, phi]))
         except np.linalg.LinAlgError:
             raise SimulationError(t, "constrained static equilibrium: singular tangent") from None
-        # backtracking on the merit |r| + k_ref |phi| (k_ref: force per metre of the tangent)
+        # the full Newton step is taken when it lowers the force residual or leaves the
+        # constraints nearly closed (|phi| < 1 mm: the quadratic phase closes them); otherwise
+        # backtracking on the merit |r| + k_ref |phi| (k_ref: force per metre of the tangent).
+        # (Weighting phi by the axial stiffness ~1e10 N/m alone rejected good full steps and cost
+        # 3x the iterations on the 25 t telescopic equilibrium.)
         k_ref = float(np.max(np.abs(np.diag(K)))) or 1.0
         merit0 = np.linalg.norm(r1) + k_ref * np.linalg.norm(phi)
         step = 1.0
         while True:
             z_try, lam_try = z + step * d[:n], lam + step * d[n:]
             Fr_t, phi_t, C_t = parts(z_try)
-            merit = np.linalg.norm(Fr_t + C_t.T @ lam_try) + k_ref * np.linalg.norm(phi_t)
-            if (np.isfinite(merit) and merit < merit0) or step < 1e-3:
+            r_t = np.linalg.norm(Fr_t + C_t.T @ lam_try)
+            merit = r_t + k_ref * np.linalg.norm(phi_t)
+            if not np.isfinite(merit):
+                pass
+            elif step == 1.0 and (r_t < np.linalg.norm(r1) or np.max(np.abs(phi_t), initial=0.0) < 1e-3):
+                break
+            elif merit < merit0:
+                break
+            if step < 1e-3:
                 break
             step *= 0.5
         if not np.isfinite(merit):

@@ -32,7 +32,7 @@ import numpy as np
 from .assemble import reference_basis
 from .beam.moving_node_beam import Beam, BeamSection
 from .constraints import (NonlinearConstraint, angle_coincidence, distance_driver, material_point,
-                          point_coincidence)
+                          point_coincidence, rope_length)
 from .drive_profiles import CubicSmoothstepSchedule
 from .effects import Effect, Elasticity, Gravity, Inertia, StressFilter
 from .model import Model, boundary_condition, fix_material_coordinate
@@ -65,7 +65,12 @@ class TelescopicParams:
     t_ramp: float = 4.0
     t_hold_end: float = 12.0
     baumgarte: tuple[float, float] = (20.0, 20.0)
-    friction: bool = False                  # sliding-block contact + Coulomb friction (Sec. 8)
+    friction: bool = False                  # Coulomb friction on the contact coordinates (Sec. 8)
+    contact_distribution: bool | None = None  # slider springs (Sec. 8); off = resultants only;
+                                              # None = on for the paper's 3 booms
+    torsion: bool = True                    # torsion angles as coordinates; off = held at zero
+    rope_elasticity: bool = True            # elastic tension-only ropes; off = one inextensible rope
+    flexible: bool = True                   # flexible booms; off = rigid kinematic limit
     mu_static: float = 0.15
     mu_dynamic: float = 0.1
     v_eps: float = 0.01                     # m/s, switching speed
@@ -92,6 +97,7 @@ class TelescopicSystem:
     rows: dict[str, slice]                  # nonlinear-constraint rows by name
     tip: callable                           # point function of the tip (boom N, s = L)
     params: TelescopicParams
+    contact: object = None                  # contact_friction.ContactFriction, if built
 
 
 def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
@@ -118,6 +124,9 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
         for end in ("left", "right"):
             lin.append(boundary_condition(offsets, beams, ib, end, "free"))
     lin.append(fix_material_coordinate(offsets, beams, 0, 1, p.L_h))
+    if not p.torsion:
+        from .assemble import _no_torsion
+        lin.append(_no_torsion(offsets, beams))
     model = Model(beams, effects, [], lin, n_extra=N - 1, baumgarte=p.baumgarte)
 
     # initial straight configuration: boom k's left section a_k = k L_s along boom 1 (A3)
@@ -147,11 +156,20 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
         cons.append(c)
         names.append((c.name, c.m))
 
+    # effects.torsion = false: the torsion angles gamma are held at zero, so the gamma rows of the
+    # angle coincidences would read 0 = 0 (a singular KKT matrix) and are left out
+    bend = [0, 1] if not p.torsion else [0, 1, 2]
+
+    def angles(name, fa, fb=None, fixed=None, keep=(0, 1, 2)):
+        c = angle_coincidence(name, fa, fb, fixed=fixed)
+        k = [i for i in keep if i in bend]
+        return c if len(k) == 3 else _rows(c, k)
+
     # pivot D1: revolute about Y (point fixed, beta = gamma = 0 at boom 1's left section)
     D1 = mp(0, s_fixed=0.0, offset=(-0.956, 0.0, 0.556))
     add(point_coincidence("pivot", D1, fixed=geo.d1))
     root = mp(0, s_fixed=0.0)
-    add(_rows(angle_coincidence("pivot_axis", root, fixed=[0.0, 0.0, 0.0]), [1, 2]))
+    add(angles("pivot_axis", root, fixed=[0.0, 0.0, 0.0], keep=(1, 2)))
     # luffing cylinder: rigid massless rod D2-D3 held at its initial length (A2)
     D3 = mp(0, s_fixed=p.L_h, offset=(0.0, 0.0, -0.556))
     Lc = float(geo.cylinder_length)
@@ -161,11 +179,11 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
         inner = mp(k, s_index=s2_index[k])
         left_next = mp(k + 1, s_fixed=0.0)
         add(point_coincidence(f"I_{k + 1}{k + 2}_point", left_next, inner))
-        add(angle_coincidence(f"I_{k + 1}{k + 2}_angles", left_next, inner))
+        add(angles(f"I_{k + 1}{k + 2}_angles", left_next, inner))
         right = mp(k, s_fixed=L)
         outer_next = mp(k + 1, s_index=s3_index[k + 1])
         add(point_coincidence(f"II_{k + 1}{k + 2}_point", right, outer_next))
-        add(angle_coincidence(f"II_{k + 1}{k + 2}_angles", right, outer_next))
+        add(angles(f"II_{k + 1}{k + 2}_angles", right, outer_next))
     # telescopic cylinder between the left sections of booms 1 and 2 (A3, A4)
     sched = CubicSmoothstepSchedule(v_max=p.v_max, t_ramp=p.t_ramp, t_hold_end=p.t_hold_end,
                                     sign=p.direction, s0=Ls)
@@ -182,29 +200,44 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
     if p.payload > 0:
         pe.append(PointMass(tip, p.payload, g_vec if p.gravity > 0 else None))
     if N >= 3:
-        rope_scale = p.E / 2.1e11
         ext = [mp(0, s_fixed=0.0, offset=(0.05, 0, 0)), mp(1, s_fixed=9.0),
                mp(2, s_fixed=0.0, offset=(-0.04, 0, 0))]
         ret = [mp(0, s_fixed=L, offset=(0.68, 0, 0)), mp(1, s_fixed=0.66),
                mp(2, s_fixed=0.0, offset=(0.64, 0, 0))]
-        EA = p.rope_EA * rope_scale
-        rope = RopeDrive(ext, EA, 1.0, name="extraction_rope")
-        ell_e = float(rope.length(Q0)[0])
-        # unstretched length from the static rope tension T = (m3 + m_p) g sin(theta) (C7)
-        T0 = static_luffing_forces(theta, Ls, p.payload, g=p.gravity).rope_tension
-        rope.L0 = ell_e / (1.0 + T0 / EA)
-        retr = RopeDrive(ret, EA, 1.0, name="retraction_rope")
-        retr.L0 = float(retr.length(Q0)[0])         # just taut
-        pe += [rope, retr]
+        if p.rope_elasticity:
+            EA = p.rope_EA * p.E / 2.1e11
+            rope = RopeDrive(ext, EA, 1.0, name="extraction_rope")
+            ell_e = float(rope.length(Q0)[0])
+            # unstretched length from the static rope tension T = (m3 + m_p) g sin(theta) (C7)
+            T0 = static_luffing_forces(theta, Ls, p.payload, g=p.gravity).rope_tension
+            rope.L0 = ell_e / (1.0 + T0 / EA)
+            retr = RopeDrive(ret, EA, 1.0, name="retraction_rope")
+            retr.L0 = float(retr.length(Q0)[0])         # just taut
+            pe += [rope, retr]
+        else:
+            # effects.rope_elasticity = false: one inextensible bilateral rope (its multiplier's
+            # sign tells which of the two ropes is taut); nothing of the rope springs is computed
+            ell_e = float(np.real(rope_length("rope", ext, 0.0).evaluate(Q0)[0][0]))
+            c = rope_length("rope", ext, ell_e)
+            cons.append(c)
+            rows["rope"] = slice(i, i + 1)
+            model.nonlinear = cons
     model.point_effects = pe
     ts = TelescopicSystem(model, Q0, sched, s2_index, s3_index, rows, tip, p)
-    if p.friction:
+    # Section 8 contact analysis: the slider-spring distribution needs the paper's three-boom
+    # slider geometry; with friction off it is only evaluated for the outputs (it does not act
+    # on the motion), with contact_distribution off it is not built at all
+    if p.contact_distribution is None:
+        p.contact_distribution = N == 3
+    if p.contact_distribution and N != 3:
+        raise ValueError(f"contact_distribution with n_booms = {N}: the slider geometry is the "
+                         "paper's three-boom section (allowed: 3)")
+    if p.friction or p.contact_distribution:
         from .contact_friction import ContactFriction
-        if N != 3:
-            raise ValueError(f"friction with n_booms = {N}: the slider geometry is the paper's "
-                             "three-boom section (allowed: 3)")
-        model.multiplier_forces = [ContactFriction(ts, p.mu_static, p.mu_dynamic, p.v_eps,
-                                                   p.spring_k0, p.spring_eps)]
+        ts.contact = ContactFriction(ts, p.mu_static, p.mu_dynamic, p.v_eps, p.spring_k0,
+                                     p.spring_eps, distribution=p.contact_distribution)
+    if p.friction:
+        model.multiplier_forces = [ts.contact]
     return ts
 
 
@@ -249,6 +282,9 @@ def simulate_telescopic(p: TelescopicParams, t_end: float = 20.0, n_output: int 
     normal force of every slider spring per region (I_12, II_12, I_23, II_23; springs ordered arc
     by arc P1, P2, P3 as in sim_core.contact) and the signed friction coefficient per region)."""
     from .simulate import integrate_rk45, run_with_partial
+    if not p.flexible:
+        from .rigid_telescopic import RigidTelescopic
+        return RigidTelescopic(p).simulate(t_end, n_output, rtol, atol)
     ts = build_telescopic(p)
     m = ts.model
     z0, _ = initial_equilibrium(ts)
@@ -296,11 +332,15 @@ def _telescopic_result(ts: TelescopicSystem, t, ys, stats, error):
                 pair.append(np.concatenate([f_sec, m_sec]))
             cpf.append(pair)
         out["contact_point_forces"].append(cpf)
-        if m.multiplier_forces:
-            sols = m.multiplier_forces[0].solve_regions(Q, Qd, lam)
-            out.setdefault("contact_spring_forces", []).append(
-                [sol.normal_force for _, _, _, sol in sols])
-            out.setdefault("friction_coefficient", []).append([mu for _, _, mu, _ in sols])
+        if ts.contact is not None:
+            sols = ts.contact.solve_regions(Q, Qd, lam)
+            if ts.contact.distribution:
+                out.setdefault("slider_contact_forces", []).append(
+                    [sol.normal_force for _, _, _, sol in sols])
+            if p.friction:
+                out.setdefault("friction_coefficient", []).append([mu for _, _, mu, _ in sols])
+        if "rope" in ts.rows:
+            out.setdefault("rope_tension", []).append(-lam[ts.rows["rope"]][0])
         out["inner_contact_s"].append(Q[ts.s2_index])
         out["outer_contact_s"].append(Q[ts.s3_index[1:]])
         out["constraint_violation"].append(np.max(np.abs(m.constraint_violation(tk, z, zd))))

@@ -10,8 +10,18 @@
                t_hold_end s (>= t_ramp)  -- the cubic schedule of Section 9 (SCENARIOS A4)
   [payload]    mass kg (>= 0)
   [ropes]      EA N (> 0)
-  [effects]    gravity (bool), filtering (bool), friction (bool: sliding-block contact
-               distribution + Coulomb friction of Section 8; off = frictionless resultants only)
+  [effects]    what is off is not built (each a separate contribution to the model):
+               flexible (bool, default true; false = rigid booms, the kinematic limit of
+               sim_core.rigid_telescopic: no beams, no contact constraints),
+               torsion (bool, default true; false = torsion angles held at zero, twist rows of
+               the angle constraints dropped), gravity (bool), filtering (bool: stress
+               averaging with [filtering] h), friction (bool, default false: Coulomb friction
+               on the contact coordinates, Section 8.3), contact_distribution (bool, default
+               true for 3 booms: slider-spring analysis of Section 8, outputs
+               slider_contact_forces, and the friction normal load = spring sum; false = only
+               the constraint resultants, friction normal load = transverse resultant),
+               rope_elasticity (bool, default true: elastic tension-only ropes with [ropes] EA;
+               false = one inextensible rope constraint, output rope_tension)
   [contact]    mu_static (>= 0), mu_dynamic (>= 0), v_eps m/s (> 0, switching speed),
                k0 N/m (> 0, radial spring stiffness), eps m (> 0, stiffness smoothing interval)
   [filtering]  h s (> 0)
@@ -77,13 +87,28 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
     check_keys(r, {"EA"}, "ropes")
     sc["ropes"] = {"EA": number(r, "EA", "ropes", 1e8, lo=0.0, lo_open=True)}
     e = raw.get("effects", {})
-    check_keys(e, {"gravity", "filtering", "friction"}, "effects")
-    sc["effects"] = {"gravity": boolean(e, "gravity", "effects", True),
+    check_keys(e, {"gravity", "filtering", "friction", "contact_distribution", "torsion",
+                   "rope_elasticity", "flexible"}, "effects")
+    three = sc["booms"]["count"] == 3
+    sc["effects"] = {"flexible": boolean(e, "flexible", "effects", True),
+                     "torsion": boolean(e, "torsion", "effects", True),
+                     "gravity": boolean(e, "gravity", "effects", True),
                      "filtering": boolean(e, "filtering", "effects", True),
-                     "friction": boolean(e, "friction", "effects", False)}
-    if sc["effects"]["friction"] and sc["booms"]["count"] != 3:
-        raise SceneError(f"effects.friction = true with booms.count = {sc['booms']['count']}: the "
-                         "slider geometry is the paper's three-boom section (allowed: 3)")
+                     "friction": boolean(e, "friction", "effects", False),
+                     "contact_distribution": boolean(e, "contact_distribution", "effects", three),
+                     "rope_elasticity": boolean(e, "rope_elasticity", "effects", True)}
+    eff = sc["effects"]
+    if eff["contact_distribution"] and not three:
+        raise SceneError(f"effects.contact_distribution = true with booms.count = "
+                         f"{sc['booms']['count']}: the slider geometry is the paper's three-boom "
+                         "section (allowed: booms.count = 3, or contact_distribution = false)")
+    if not eff["flexible"]:
+        if sc["booms"]["count"] not in (2, 3):
+            raise SceneError(f"effects.flexible = false with booms.count = {sc['booms']['count']}: "
+                             "the rigid limit has the paper's drive (allowed: 2 or 3)")
+        if eff["friction"]:
+            raise SceneError("effects.friction = true with effects.flexible = false: rigid contact "
+                             "reactions are statically indeterminate (allowed: friction = false)")
     c = raw.get("contact", {})
     check_keys(c, {"mu_static", "mu_dynamic", "v_eps", "k0", "eps"}, "contact")
     sc["contact"] = {"mu_static": number(c, "mu_static", "contact", 0.15, lo=0.0),
@@ -113,4 +138,7 @@ def params_from_scene(sc: dict):
         v_max=d["v_max"], t_ramp=d["t_ramp"], t_hold_end=d["t_hold_end"],
         friction=sc["effects"]["friction"], mu_static=sc["contact"]["mu_static"],
         mu_dynamic=sc["contact"]["mu_dynamic"], v_eps=sc["contact"]["v_eps"],
-        spring_k0=sc["contact"]["k0"], spring_eps=sc["contact"]["eps"])
+        spring_k0=sc["contact"]["k0"], spring_eps=sc["contact"]["eps"],
+        contact_distribution=sc["effects"]["contact_distribution"],
+        torsion=sc["effects"]["torsion"], rope_elasticity=sc["effects"]["rope_elasticity"],
+        flexible=sc["effects"]["flexible"])
