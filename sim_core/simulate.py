@@ -18,24 +18,44 @@ from .statics import static_equilibrium
 
 
 class _CountingRHS:
-    """Wraps model.rhs: counts evaluations and turns non-finite values into SimulationError."""
+    """Wraps model.rhs: counts evaluations.  A stage evaluation that fails (overflow, singular
+    KKT matrix, non-finite accelerations) is a *recoverable* failure, as in SUNDIALS: the stage
+    returns huge derivatives so that the error estimate rejects the step and RK45 retries with a
+    smaller one.  After ``max_failures`` consecutive failed evaluations, or if an accepted state
+    is non-finite (checked by the caller), it raises SimulationError with the time and reason."""
+
+    BIG = 1e100
+    max_failures = 40
 
     def __init__(self, model):
         self.model = model
         self.nfev = 0
         self.last_t = 0.0
+        self.failures = 0
+        self.n_failed = 0
+        self.last_reason = ""
 
     def __call__(self, t, y):
         self.nfev += 1
         self.last_t = t
+        reason = None
         try:
             with np.errstate(over="raise", divide="raise", invalid="raise", under="ignore"):
                 out = self.model.rhs(t, y)
+            if not np.all(np.isfinite(out)):
+                reason = "non-finite accelerations"
         except (FloatingPointError, np.linalg.LinAlgError) as exc:
-            raise SimulationError(t, f"non-finite or singular dynamics: {exc}", last_state=y) from None
-        if not np.all(np.isfinite(out)):
-            raise SimulationError(t, "non-finite accelerations", last_state=y)
-        return out
+            reason = f"non-finite or singular dynamics: {exc}"
+        if reason is None:
+            self.failures = 0
+            return out
+        self.failures += 1
+        self.n_failed += 1
+        self.last_reason = reason
+        if self.failures > self.max_failures:
+            raise SimulationError(t, f"{reason} ({self.failures} consecutive failed stage "
+                                     "evaluations; step size could not recover)", last_state=y)
+        return np.full(len(y), self.BIG)
 
 
 def integrate_rk45(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
@@ -54,6 +74,7 @@ def integrate_rk45(model, y0: np.ndarray, t_end: float, sol: dict, progress=None
     def stats():
         wall = time.perf_counter() - wall0
         return {"wall_time_s": wall, "n_steps": len(steps), "n_rhs": int(rhs.nfev),
+                "n_failed_rhs": int(rhs.n_failed),
                 "min_step_s": float(min(steps)) if steps else 0.0,
                 "max_step_s": float(max(steps)) if steps else 0.0,
                 "method": "RK45", "real_time_factor": t_end / max(wall, 1e-12)}
@@ -62,7 +83,9 @@ def integrate_rk45(model, y0: np.ndarray, t_end: float, sol: dict, progress=None
         while solver.status == "running":
             msg = solver.step()
             if solver.status == "failed" or not np.all(np.isfinite(solver.y)):
-                raise SimulationError(solver.t, f"RK45 failed: {msg}", step=solver.step_size,
+                why = (f" after {rhs.failures} failed stage evaluations ({rhs.last_reason})"
+                       if rhs.failures else "")
+                raise SimulationError(solver.t, f"RK45 failed: {msg}{why}", step=solver.step_size,
                                       last_state=solver.y)
             steps.append(solver.t - solver.t_old)
             if k_out < len(t_eval) and t_eval[k_out] <= solver.t:
