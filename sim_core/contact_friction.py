@@ -49,7 +49,8 @@ class ContactFriction:
     name = "friction"
 
     def __init__(self, ts, mu_static: float, mu_dynamic: float, v_eps: float,
-                 k0: float = 1e9, eps: float = 1e-6, distribution: bool = True):
+                 k0: float = 1e9, eps: float = 1e-6, distribution: bool = True,
+                 slider_half_width: float = 0.15, springs_per_quarter: int = 20):
         self.ts = ts
         self.distribution = distribution
         self.law = FrictionLaw(mu_static, mu_dynamic, v_eps)
@@ -61,8 +62,9 @@ class ContactFriction:
         for k in range(ts.params.n_booms - 1):
             inner = material_point(m, k, s_index=ts.s2_index[k])
             outer = material_point(m, k + 1, s_index=ts.s3_index[k + 1])
-            geo = ((SliderGeometry.paper_region(k + 1, "inner"),
-                    SliderGeometry.paper_region(k + 1, "outer")) if distribution else (None, None))
+            geo = tuple(SliderGeometry.paper_region(k + 1, kind, springs_per_quarter,
+                                                    slider_half_width)
+                        for kind in ("inner", "outer")) if distribution else (None, None)
             self.regions.append((f"I_{k + 1}{k + 2}", inner, ts.s2_index[k], geo[0]))
             self.regions.append((f"II_{k + 1}{k + 2}", outer, ts.s3_index[k + 1], geo[1]))
         self._x0 = {}

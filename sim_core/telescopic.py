@@ -76,6 +76,8 @@ class TelescopicParams:
     v_eps: float = 0.01                     # m/s, switching speed
     spring_k0: float = 1e9                  # N/m per radial spring (SCENARIOS A6)
     spring_eps: float = 1e-6                # m, smoothing interval
+    slider_width: float = 0.3               # m, 2w: slider length along the boom (SCENARIOS A1)
+    springs_per_quarter: int = 20           # radial springs per quarter arc and slider end (A6)
     sections: tuple = field(default=TABLE2)
 
 
@@ -235,7 +237,9 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
     if p.friction or p.contact_distribution:
         from .contact_friction import ContactFriction
         ts.contact = ContactFriction(ts, p.mu_static, p.mu_dynamic, p.v_eps, p.spring_k0,
-                                     p.spring_eps, distribution=p.contact_distribution)
+                                     p.spring_eps, distribution=p.contact_distribution,
+                                     slider_half_width=0.5 * p.slider_width,
+                                     springs_per_quarter=p.springs_per_quarter)
     if p.friction:
         model.multiplier_forces = [ts.contact]
     return ts

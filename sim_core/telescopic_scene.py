@@ -23,7 +23,9 @@
                rope_elasticity (bool, default true: elastic tension-only ropes with [ropes] EA;
                false = one inextensible rope constraint, output rope_tension)
   [contact]    mu_static (>= 0), mu_dynamic (>= 0), v_eps m/s (> 0, switching speed),
-               k0 N/m (> 0, radial spring stiffness), eps m (> 0, stiffness smoothing interval)
+               k0 N/m (> 0, radial spring stiffness), eps m (> 0, stiffness smoothing interval),
+               slider_width m (2w, > 0 and shorter than the smallest overlap L - max L_s),
+               springs_per_quarter (1..200 springs per quarter arc and slider end)
   [filtering]  h s (> 0)
   [gravity]    g m/s^2 (> 0, along -Z)
 Geometry rules: the stroke history must keep each boom inside its neighbour: with L_s(t) the
@@ -110,12 +112,25 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
             raise SceneError("effects.friction = true with effects.flexible = false: rigid contact "
                              "reactions are statically indeterminate (allowed: friction = false)")
     c = raw.get("contact", {})
-    check_keys(c, {"mu_static", "mu_dynamic", "v_eps", "k0", "eps"}, "contact")
+    check_keys(c, {"mu_static", "mu_dynamic", "v_eps", "k0", "eps", "slider_width",
+                   "springs_per_quarter"}, "contact")
     sc["contact"] = {"mu_static": number(c, "mu_static", "contact", 0.15, lo=0.0),
                      "mu_dynamic": number(c, "mu_dynamic", "contact", 0.1, lo=0.0),
                      "v_eps": number(c, "v_eps", "contact", 0.01, lo=0.0, lo_open=True),
                      "k0": number(c, "k0", "contact", 1e9, lo=0.0, lo_open=True),
-                     "eps": number(c, "eps", "contact", 1e-6, lo=0.0, lo_open=True)}
+                     "eps": number(c, "eps", "contact", 1e-6, lo=0.0, lo_open=True),
+                     "slider_width": number(c, "slider_width", "contact", 0.3, lo=0.0,
+                                            lo_open=True),
+                     "springs_per_quarter": number(c, "springs_per_quarter", "contact", 20,
+                                                   lo=1, hi=200, integer=True)}
+    # the two sliders of a pair (boom k+1's left-end slider inside boom k, boom k's right-end
+    # slider on boom k+1) must fit in the overlap L - L_s(t) at its shortest
+    ls_max = max(sc["booms"]["stroke0"], end)
+    overlap = L - ls_max
+    if sc["contact"]["slider_width"] >= overlap:
+        raise SceneError(f"contact.slider_width = {sc['contact']['slider_width']:g} m does not fit "
+                         f"the shortest overlap of adjacent booms, booms.length - max L_s = "
+                         f"{overlap:g} m (allowed: 0 < slider_width < {overlap:g} m)")
     f = raw.get("filtering", {})
     check_keys(f, {"h"}, "filtering")
     sc["filtering"] = {"h": number(f, "h", "filtering", 0.01, lo=0.0, lo_open=True)}
@@ -140,5 +155,7 @@ def params_from_scene(sc: dict):
         mu_dynamic=sc["contact"]["mu_dynamic"], v_eps=sc["contact"]["v_eps"],
         spring_k0=sc["contact"]["k0"], spring_eps=sc["contact"]["eps"],
         contact_distribution=sc["effects"]["contact_distribution"],
+        slider_width=sc["contact"]["slider_width"],
+        springs_per_quarter=sc["contact"]["springs_per_quarter"],
         torsion=sc["effects"]["torsion"], rope_elasticity=sc["effects"]["rope_elasticity"],
         flexible=sc["effects"]["flexible"])

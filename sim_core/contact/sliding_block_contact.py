@@ -311,7 +311,8 @@ class SliderGeometry:
         return m
 
     @classmethod
-    def paper_region(cls, pair, kind: str, springs_per_quarter: int = 20) -> "SliderGeometry":
+    def paper_region(cls, pair, kind: str, springs_per_quarter: int = 20,
+                     half_width: float | None = None) -> "SliderGeometry":
         """A contact region of the paper's three-boom example (Section 9, SCENARIOS A1/A6).
 
         pair : outer boom index k of the pair (k, k+1): 1, 2, or (1, 2), (2, 3), "1-2", "2-3".
@@ -319,7 +320,8 @@ class SliderGeometry:
             "outer" (outer contact section of boom k+1, right-end slider of boom k, k_t = +1).
         Arcs P1 centre (0.3, 0.3), 0-90 deg; P2 (-0.3, 0.3), 90-180 deg; P3 (0, 0), 180-360 deg;
         contact radius = mid-gap between boom k's inner face (outer radius - 15 mm) and boom
-        k+1's outer face: 72.5/372.5 mm (pair 1-2), 52.5/352.5 mm (pair 2-3); w = 0.15 m.
+        k+1's outer face: 72.5/372.5 mm (pair 1-2), 52.5/352.5 mm (pair 2-3); w = 0.15 m unless
+        ``half_width`` (m) is given.
         """
         if isinstance(pair, str):
             pair = tuple(int(p) for p in pair.replace("–", "-").split("-"))
@@ -341,7 +343,8 @@ class SliderGeometry:
             [-_TOP_CENTRE, _TOP_CENTRE, r_top, 0.5 * math.pi, math.pi, nq],     # P2 top left
             [0.0, 0.0, r_half, math.pi, 2.0 * math.pi, 2 * nq],                 # P3 lower half
         ])
-        return cls(_HALF_WIDTH, arcs, -1 if kind == "inner" else 1,
+        return cls(_HALF_WIDTH if half_width is None else half_width, arcs,
+                   -1 if kind == "inner" else 1,
                    name=f"pair {k}-{k + 1} {kind}")
 
 

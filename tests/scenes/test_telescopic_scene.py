@@ -1,0 +1,123 @@
+"""Telescopic scene files: every validation rule (one bad value each, the message checked), the
+effect switches as the scene resolves them, and the CLI's exit status on a bad scene."""
+
+import math
+import subprocess
+import sys
+
+import pytest
+
+from sim_core import SceneError, load_scene
+from sim_core.scene import shipped_scenes
+from sim_core.telescopic_scene import params_from_scene
+
+SCENE = "telescopic_extraction"
+
+
+def _err(overrides, scene=SCENE) -> str:
+    with pytest.raises(SceneError) as info:
+        load_scene(scene, overrides=overrides)
+    return str(info.value)
+
+
+@pytest.mark.parametrize("name", [n for n in shipped_scenes() if n.startswith("telescopic")])
+def test_shipped_telescopic_scenes_are_valid(name):
+    sc = load_scene(name)
+    p = params_from_scene(sc)
+    assert p.n_booms == sc["booms"]["count"] and p.boom_length > 0
+
+
+@pytest.mark.parametrize("key, value, allowed", [
+    ("booms.length", 0.0, "(0, inf)"),
+    ("booms.length", -10.0, "(0, inf)"),
+    ("booms.E", 0.0, "(0, inf)"),
+    ("booms.rho", -7850.0, "(0, inf)"),
+    ("payload.mass", -1.0, "[0, inf)"),
+    ("ropes.EA", 0.0, "(0, inf)"),
+    ("contact.k0", 0.0, "(0, inf)"),
+    ("contact.eps", 0.0, "(0, inf)"),
+    ("contact.v_eps", 0.0, "(0, inf)"),
+    ("contact.mu_static", -0.1, "[0, inf)"),
+    ("contact.slider_width", 0.0, "(0, inf)"),
+    ("contact.springs_per_quarter", 0, "[1, 200]"),
+    ("filtering.h", 0.0, "(0, inf)"),
+    ("solver.t_end", 0.0, "(0, inf)"),
+    ("solver.rtol", 1.0, "(0, 1)"),
+    ("booms.luffing_angle_deg", 90.0, "[0, 85]"),
+    ("booms.n_nodes", 2, "[3, 33]"),
+])
+def test_out_of_range_value_names_field_value_and_range(key, value, allowed):
+    msg = _err({key: value})
+    assert msg.startswith(f"{key} = {value!r}") and allowed in msg
+
+
+@pytest.mark.parametrize("count", [1, 0, 6])
+def test_boom_count_outside_two_to_five(count):
+    msg = _err({"booms.count": count, "effects.friction": False,
+                "effects.contact_distribution": False})
+    assert "booms.count" in msg and "[2, 5]" in msg
+
+
+@pytest.mark.parametrize("key", ["booms.E", "payload.mass", "drive.v_max", "contact.k0"])
+@pytest.mark.parametrize("bad", [math.nan, math.inf])
+def test_nan_or_inf_anywhere(key, bad):
+    msg = _err({key: bad})
+    assert key in msg and "finite" in msg
+
+
+def test_stroke_history_that_pulls_a_boom_out():
+    msg = _err({"drive.v_max": 1.0})          # 2 + 1.0 * 12 = 14 m > 10 m boom
+    assert "drive" in msg and "outside the allowed (0, 10) m" in msg
+
+
+def test_retraction_that_pushes_through_the_end():
+    msg = _err({"drive.v_max": 1.0}, scene="telescopic_retraction")   # 8 - 12 < 0
+    assert "outside the allowed (0, 10) m" in msg
+
+
+def test_stroke0_beyond_the_boom():
+    msg = _err({"booms.stroke0": 10.0})
+    assert msg.startswith("booms.stroke0 = 10.0") and "(0, 10)" in msg
+
+
+def test_slider_wider_than_the_overlap():
+    # extraction to L_s = 8 m leaves a 2 m overlap; two 1.2 m sliders do not fit
+    msg = _err({"contact.slider_width": 2.0})
+    assert "contact.slider_width = 2" in msg and "0 < slider_width < 2 m" in msg
+
+
+def test_unknown_key_suggests():
+    msg = _err({"effects.fricton": False})
+    assert "effects.fricton: unknown key" in msg and "did you mean 'friction'" in msg
+
+
+def test_contact_distribution_needs_the_paper_three_booms():
+    msg = _err({"booms.count": 4, "effects.friction": False, "effects.contact_distribution": True})
+    assert "effects.contact_distribution = true with booms.count = 4" in msg
+
+
+def test_rigid_limit_rejects_friction():
+    msg = _err({"effects.flexible": False})      # the paper scene has friction on
+    assert "effects.friction = true with effects.flexible = false" in msg
+
+
+def test_effect_switches_reach_the_model_parameters():
+    sc = load_scene(SCENE, overrides={"effects.friction": False, "effects.torsion": False,
+                                      "effects.rope_elasticity": False,
+                                      "effects.contact_distribution": False,
+                                      "effects.filtering": False, "effects.gravity": False})
+    p = params_from_scene(sc)
+    assert (p.friction, p.torsion, p.rope_elasticity, p.contact_distribution) == (False,) * 4
+    assert p.filter_h == 0.0 and p.gravity == 0.0 and p.flexible
+
+
+def test_contact_distribution_defaults_off_for_other_boom_counts():
+    sc = load_scene(SCENE, overrides={"booms.count": 2, "effects.friction": False})
+    assert sc["effects"]["contact_distribution"] is False
+
+
+def test_cli_exits_2_with_one_line_on_a_bad_telescopic_scene():
+    proc = subprocess.run([sys.executable, "-m", "sim_core.cli", "describe", SCENE,
+                           "--set", "booms.E=-1"], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2
+    assert "booms.E = -1" in proc.stderr and "Traceback" not in proc.stderr
