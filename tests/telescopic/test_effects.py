@@ -155,3 +155,23 @@ def test_friction_off_equals_mu_zero():
     np.testing.assert_allclose(r1["tip_position"], r0["tip_position"], atol=1e-9)
     np.testing.assert_allclose(r1["telescopic_cylinder_force"], r0["telescopic_cylinder_force"],
                                rtol=1e-6)
+
+
+def test_frictionless_contact_carries_no_axial_force(equilibria):
+    """Without friction nothing resists a relative slide: the contact coordinates carry no
+    generalized force (Section 7: eta = 0; Eq. 72 with mu = 0), i.e. r' . f + psi' . lambda_psi
+    = 0.  The axial force f_s is then only the curvature coupling psi' . lambda_psi (the contact
+    moment times the boom curvature), below 1 % of the transverse force for these nearly straight
+    booms (measured 2e-4); in region II the junction node's coordinate also carries the
+    discretisation-level elastic flux of the moving node, under the same bound."""
+    ts, z, lam = equilibria["full"]
+    m = ts.model
+    Q, _ = m.full_state(0.0, z, np.zeros_like(z))
+    basis = m.beams[0].reference_basis
+    for k in range(ts.params.n_booms - 1):
+        for name, point in ((f"I_{k + 1}{k + 2}", material_point(m, k, s_index=ts.s2_index[k])),
+                            (f"II_{k + 1}{k + 2}",
+                             material_point(m, k + 1, s_index=ts.s3_index[k + 1]))):
+            f, _ = section_reaction(point, Q, lam[ts.rows[name + "_point"]],
+                                    lam[ts.rows[name + "_angles"]], basis)
+            assert abs(f[0]) <= 1e-2 * np.hypot(f[1], f[2]), (name, f)
