@@ -341,8 +341,12 @@ class ModalROM:
     """State (L_s m, v m/s, q (n,), q_dot (n,)) of the stroke-parametric modal ROM.
 
     ``advance(a, dt)`` integrates one interval of constant piston acceleration a (m/s^2): the
-    stroke kinematics exactly (L += v dt + a dt^2/2), the modal equations with classical RK4 on
-    sub-steps h <= 1 / omega_max (RK4 amplitude error O((omega h)^4 / 120) per step)."""
+    stroke kinematics exactly (L += v dt + a dt^2/2) and the modal equations exactly for the
+    coefficients frozen at the interval's mid-stroke (midpoint rule in L_s: second order in
+    the coefficient change v dt, which is <= 0.025 m per 0.05 s step against a 0.65 m table
+    grid).  With v = v0 + a t the right-hand side is a quadratic in t; the particular solution
+    is the matching quadratic and the homogeneous part the closed-form damped oscillation
+    (all tabulated modes have zeta < 1)."""
 
     def __init__(self, tables: ModalTables, L0: float, v0: float = 0.0):
         self.tb = tables
@@ -350,29 +354,38 @@ class ModalROM:
         self.L, self.v = float(L0), float(v0)
         self.q = np.zeros(n)
         self.qd = np.zeros(n)
-        wmax = float(np.max(tables.coef[:, 0, :]))
-        self.h_max = 1.0 / wmax
-
-    def _acc(self, L, v, a, q, qd):
-        c = self.tb.coefficients(L)
-        w, z, g, g2, b1, b2 = c[0], c[1], c[2], c[3], c[4], c[5]
-        return -g * a - (g2 - b2) * v * v + b1 * v - 2 * z * w * qd - w * w * q
 
     def advance(self, a: float, dt: float) -> None:
-        n_sub = max(1, int(np.ceil(dt / self.h_max - 1e-9)))
-        h = dt / n_sub
-        L, v, q, qd = self.L, self.v, self.q, self.qd
-        for _ in range(n_sub):
-            Lm, vm = L + 0.5 * h * v + 0.125 * a * h * h, v + 0.5 * h * a
-            L1, v1 = L + h * v + 0.5 * a * h * h, v + h * a
-            k1q, k1v = qd, self._acc(L, v, a, q, qd)
-            k2q, k2v = qd + 0.5 * h * k1v, self._acc(Lm, vm, a, q + 0.5 * h * k1q, qd + 0.5 * h * k1v)
-            k3q, k3v = qd + 0.5 * h * k2v, self._acc(Lm, vm, a, q + 0.5 * h * k2q, qd + 0.5 * h * k2v)
-            k4q, k4v = qd + h * k3v, self._acc(L1, v1, a, q + h * k3q, qd + h * k3v)
-            q = q + h / 6 * (k1q + 2 * k2q + 2 * k3q + k4q)
-            qd = qd + h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v)
-            L, v = L1, v1
-        self.L, self.v, self.q, self.qd = L, v, q, qd
+        L, v0 = self.L, self.v
+        c = self.tb.coefficients(L + 0.5 * v0 * dt + 0.125 * a * dt * dt)
+        w, z, g, g2, b1, b2 = c[0], c[1], c[2], c[3], c[4], c[5]
+        # f(t) = -g a - (g2 - b2) (v0 + a t)^2 + b1 (v0 + a t) = f0 + f1 t + f2 t^2
+        k = g2 - b2
+        f0 = -g * a - k * v0 * v0 + b1 * v0
+        f1 = -2.0 * k * v0 * a + b1 * a
+        f2 = -k * a * a
+        w2 = w * w
+        sig = z * w
+        C = f2 / w2
+        B = (f1 - 4.0 * sig * C) / w2
+        A = (f0 - 2.0 * sig * B - 2.0 * C) / w2
+        x0 = self.q - A
+        y0 = self.qd - B
+        wd = w * np.sqrt(1.0 - z * z)
+        e = np.exp(-sig * dt)
+        cs, sn = np.cos(wd * dt), np.sin(wd * dt)
+        x = e * (x0 * cs + (y0 + sig * x0) / wd * sn)
+        y = e * (y0 * cs - (w2 * x0 + sig * y0) / wd * sn)
+        self.q = x + A + B * dt + C * dt * dt
+        self.qd = y + B + 2.0 * C * dt
+        self.L = L + v0 * dt + 0.5 * a * dt * dt
+        self.v = v0 + a * dt
+
+    def deflection(self):
+        """(dX, dZ, dX', dZ') of the tip from the static tip at the current L_s (m, m/s)."""
+        c = self.tb.coefficients(self.L)
+        return (float(c[6] @ self.q), float(c[7] @ self.q), float(c[6] @ self.qd),
+                float(c[7] @ self.qd))
 
     def tip(self):
         """Tip position (3,) m, velocity (3,) m/s and deflection from the static tip (3,) m
@@ -435,9 +448,9 @@ def simulate_modal(p, n_modes: int, t_end: float, n_output: int, dt_max: float =
     for t_next in t_out[1:]:
         n = max(1, int(np.ceil((t_next - t) / dt_max - 1e-9)))
         h = (t_next - t) / n
+        v = sched.rate(t + h * np.arange(n + 1))          # one vectorised schedule call
         for k in range(n):
-            a = float(sched.rate(t + (k + 1) * h) - sched.rate(t + k * h)) / h
-            rom.advance(a, h)
+            rom.advance(float(v[k + 1] - v[k]) / h, h)
         t = t_next
         record()
     wall = time.perf_counter() - wall0
