@@ -9,8 +9,8 @@ Dynamics (``fidelity``)
 -----------------------
 * ``"rl"`` (default): the stroke-parametric modal reduced-order model
   ``sim_core.modal_telescopic`` (in-plane modes of the full sim_core model, linearised about the
-  static equilibrium at each L_s; tables shipped in sim_core/data).  ~10^4 env steps/s, i.e.
-  several hundred times real time on one core (benchmarks/env_speed.md).
+  static equilibrium at each L_s; tables shipped in sim_core/data).  1000-3000 env steps/s
+  on one loaded core, 50-150 times real time (benchmarks/env_speed.md).
 * ``"paper"``: the full sim_core model (``sim_core.telescopic``, frictionless by default,
   ``paper_n_nodes`` nodes per spline element, default 3) advanced step by step: for each control
   step the telescopic-cylinder constraint target is replaced by the env's stroke kinematics and
