@@ -53,7 +53,9 @@ Observation space
 
 The deflection is the tip position (boom 3, s = 10 m) minus the static-equilibrium tip of the
 same model at the current L_s (tables of the full model), i.e. the vibration plus the
-quasi-static inertial deflection.  Deflections are mm-scale: normalise observations
+quasi-static inertial deflection.  With ``fidelity="paper"`` the reference is the full model's
+own equilibrium tip at reset moved by the tables' static tip change (the tables interpolate
+across the retraction rope's slack/taut switch near L_s = 2 m, ~1 mm off there).  Deflections are mm-scale: normalise observations
 (e.g. VecNormalize) for learning.  A deflection outside its bounds counts as divergence.
 
 Reward (per step; all weights are constructor arguments)
@@ -333,7 +335,7 @@ class TelescopicBoomEnv(gym.Env):
         else:
             r, v = self._paper_tip()
             rs, drs = self.tables.static_tip(self.rom.L)
-            d, dv = r - rs, v - drs * self.rom.v
+            d, dv = r - rs - self._tip_offset, v - drs * self.rom.v
         self._defl = np.array([d[0], d[2], dv[0], dv[2]], dtype=np.float64)
 
     # -- paper fidelity -----------------------------------------------------------------------
@@ -349,6 +351,10 @@ class TelescopicBoomEnv(gym.Env):
         self._cyl = next(c for c in self._ts.model.nonlinear if c.name == "telescopic_cylinder")
         self._kin = (L0, 0.0, [])
         self._cyl.target = self._target
+        # deflection reference: the model's own equilibrium tip at the start, moved with the
+        # tables' static tip (the tables interpolate across the retraction rope's slack/taut
+        # switch near L_s = 2 m: ~1 mm off there, more than the dynamic response)
+        self._tip_offset = self._paper_tip()[0] - self.tables.static_tip(L0)[0]
 
     def _target(self, t):
         """Cylinder length, rate, acceleration at local time t (s) of the current step."""
