@@ -454,7 +454,7 @@ def simulate_modal(p, n_modes: int, t_end: float, n_output: int, dt_max: float =
         t = t_next
         record()
     wall = time.perf_counter() - wall0
-    stats = {"wall_time_s": wall, "method": "modal ROM (RK4)", "n_modes": n_modes,
+    stats = {"wall_time_s": wall, "method": "modal ROM (exact frozen-coefficient steps)", "n_modes": n_modes,
              "real_time_factor": t_end / max(wall, 1e-12), "n_dof": n_modes}
     scene = {"name": "telescopic", "params": {k: v for k, v in p.__dict__.items() if k != "sections"}}
     return Result(t_out, {k: np.array(v, float) for k, v in out.items()}, stats, scene, None)
