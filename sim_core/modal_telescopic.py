@@ -403,7 +403,9 @@ def check_params(p) -> None:
     from .telescopic import TelescopicParams
     ref = TelescopicParams()
     for k in ("n_booms", "boom_length", "L_h", "E", "rho", "rope_EA", "gravity", "filter_h",
-              "sections"):
+              "sections", "torsion", "rope_elasticity", "flexible", "contact_distribution"):
+        if not hasattr(ref, k):             # options of later sim_core versions
+            continue
         if getattr(p, k) != getattr(ref, k):
             raise ValueError(f"{k} = {getattr(p, k)!r}: the modal tables are built for "
                              f"{getattr(ref, k)!r}; use the full model (model.reduction = 'none')")
