@@ -1,5 +1,26 @@
 """boom_env: Gymnasium environments on top of sim_core (telescopic extraction/retraction).
 
-Not implemented yet: the environments depend on the telescopic boom system of sim_core
-(issue "Telescopic boom system"); importing this package registers nothing so far.
+    import gymnasium as gym
+    import boom_env  # noqa: F401  (registers the environments)
+    env = gym.make("boom_env/TelescopicExtraction-v0")            # fidelity="rl" (modal ROM)
+    env = gym.make("boom_env/TelescopicRetraction-v0", fidelity="paper")   # full model, slow
+
+See boom_env.telescopic_env for observation, action, reward, start state and episode end.
 """
+
+from gymnasium.envs.registration import register, registry
+
+from .telescopic_env import TelescopicBoomEnv
+
+DT = 0.05                  # s, control step (default of TelescopicBoomEnv)
+T_MAX = 30.0               # s, episode length
+MAX_EPISODE_STEPS = int(round(T_MAX / DT))
+
+for _id, _task in (("boom_env/TelescopicExtraction-v0", "extraction"),
+                   ("boom_env/TelescopicRetraction-v0", "retraction")):
+    if _id not in registry:
+        register(id=_id, entry_point="boom_env.telescopic_env:TelescopicBoomEnv",
+                 max_episode_steps=MAX_EPISODE_STEPS,
+                 kwargs={"task": _task, "dt": DT, "t_max": T_MAX})
+
+__all__ = ["TelescopicBoomEnv", "MAX_EPISODE_STEPS"]

@@ -127,6 +127,12 @@ def simulate(scene: dict, progress=None) -> Result:
         from .telescopic import simulate_telescopic
         from .telescopic_scene import params_from_scene
         sol = scene["solver"]
+        if scene.get("model", {}).get("reduction") == "modal":
+            from .modal_telescopic import simulate_modal
+            res = simulate_modal(params_from_scene(scene), scene["model"]["n_modes"],
+                                 sol["t_end"], sol["n_output"])
+            res.scene = scene
+            return res
         res = simulate_telescopic(params_from_scene(scene), sol["t_end"], sol["n_output"],
                                   sol["rtol"], sol["atol"], progress)
         res.scene = scene

@@ -28,6 +28,9 @@
                springs_per_quarter (1..200 springs per quarter arc and slider end)
   [filtering]  h s (> 0)
   [gravity]    g m/s^2 (> 0, along -Z)
+  [model]      reduction ("none" = full model, "modal" = stroke-parametric modal ROM of
+               sim_core.modal_telescopic, tables built from the full model), n_modes (1..4,
+               in-plane modes kept by the ROM; default 3)
 Geometry rules: the stroke history must keep each boom inside its neighbour: with L_s(t) the
 piston length, 0 < L_s(t) < length for all t in [0, t_end] (error names drive/booms fields).
 """
@@ -40,7 +43,7 @@ from .errors import SceneError
 from .scene import boolean, check_keys, choice, number
 
 _TOP = {"kind", "name", "description", "solver", "booms", "drive", "payload", "ropes", "effects",
-        "filtering", "gravity", "contact", "notes"}
+        "filtering", "gravity", "contact", "notes", "model"}
 
 
 def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
@@ -137,6 +140,13 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
     g = raw.get("gravity", {})
     check_keys(g, {"g"}, "gravity")
     sc["gravity"] = {"g": number(g, "g", "gravity", 9.81, lo=0.0, lo_open=True)}
+    mo = raw.get("model", {})
+    check_keys(mo, {"reduction", "n_modes"}, "model")
+    sc["model"] = {"reduction": choice(mo, "reduction", "model", ("none", "modal"), "none"),
+                   "n_modes": number(mo, "n_modes", "model", 3, lo=1, hi=4, integer=True)}
+    if sc["model"]["reduction"] == "modal" and sc["effects"]["friction"]:
+        raise SceneError("model.reduction = 'modal' with effects.friction = true: the modal tables "
+                         "are frictionless; set effects.friction = false")
     return sc
 
 

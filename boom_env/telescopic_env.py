@@ -1,0 +1,455 @@
+"""Telescopic-boom extraction / retraction with vibration suppression (Gymnasium environment).
+
+The crane of Zhao-Qi-Wang 2024 (three nested flexible booms, 60 deg luffing angle, payload at
+boom 3's tip) extends (or retracts) its telescopic cylinder from a start to a target piston
+length L_s.  The agent commands the cylinder acceleration; the flexible booms respond.  The goal
+is to reach the target quickly while leaving as little tip vibration as possible.
+
+Dynamics (``fidelity``)
+-----------------------
+* ``"rl"`` (default): the stroke-parametric modal reduced-order model
+  ``sim_core.modal_telescopic`` (in-plane modes of the full sim_core model, linearised about the
+  static equilibrium at each L_s; tables shipped in sim_core/data).  1000-3000 env steps/s
+  on one loaded core, 50-150 times real time (benchmarks/env_speed.md).
+* ``"paper"``: the full sim_core model (``sim_core.telescopic``, frictionless by default,
+  ``paper_n_nodes`` nodes per spline element, default 3) advanced step by step: for each control
+  step the telescopic-cylinder constraint target is replaced by the env's stroke kinematics and
+  the model is integrated with ``sim_core.simulate.integrate_rk45`` (rtol 1e-6, atol 1e-7) from
+  the current state.  Slow: a real-time factor of order 0.1 or less; for checking policies, not
+  for training.
+
+Stroke kinematics (both fidelities)
+-----------------------------------
+The action is held for one control step ``dt`` (s) (piecewise-constant acceleration), the env
+integrates L_s, v exactly: velocity saturation |v| <= v_max (the cylinder's flow limit: the
+acceleration is cut to 0 when the limit is reached, ``info["velocity_saturated"]``), end stops
+L_min <= L_s <= L_max (inelastic: v -> 0 on contact, ``info["end_stop"]``; in the ROM the
+velocity jump dv gives the modal velocity jump dq' = -Gamma dv of q'' = -Gamma a).
+
+Action space
+------------
+``Box(-1, 1, (1,), float32)``: commanded cylinder acceleration a = action * a_max (m/s^2),
+a_max = 0.25 m/s^2 by default (the paper's cubic schedule, SCENARIOS A4, peaks at
+1.5 * 0.5 / 4 = 0.1875 m/s^2).  Non-finite actions raise ValueError; finite actions outside
+[-1, 1] are clipped.
+
+Observation space
+-----------------
+``Box(low, high, (9,), float32)``, SI units:
+
+====  ===============================================  ==================
+ idx  quantity                                          bounds
+====  ===============================================  ==================
+  0   piston length L_s (m)                             [L_min, L_max]
+  1   stroke rate v = dL_s/dt (m/s)                     [-v_max, v_max]
+  2   applied acceleration of the last step (m/s^2)     [-a_max, a_max]
+  3   target piston length L* (m)                       [L_min, L_max]
+  4   time left t_max - t (s)                           [0, t_max]
+  5   tip deflection dX (m) from the static tip at L_s  [-1, 1]
+  6   tip deflection dZ (m)                             [-1, 1]
+  7   rate of dX (m/s)                                  [-10, 10]
+  8   rate of dZ (m/s)                                  [-10, 10]
+====  ===============================================  ==================
+
+The deflection is the tip position (boom 3, s = 10 m) minus the static-equilibrium tip of the
+same model at the current L_s (tables of the full model), i.e. the vibration plus the
+quasi-static inertial deflection.  With ``fidelity="paper"`` the reference is the full model's
+own equilibrium tip at reset moved by the tables' static tip change (the tables interpolate
+across the retraction rope's slack/taut switch near L_s = 2 m, ~1 mm off there).  Deflections are mm-scale: normalise observations
+(e.g. VecNormalize) for learning.  A deflection outside its bounds counts as divergence.
+
+Reward (per step; all weights are constructor arguments)
+--------------------------------------------------------
+    r = - w_time * dt                                        (slowness)
+        - w_progress * |L_s - L*| / travel * dt              (distance to go)
+        - w_deflection * (|d| / d_ref)^2 * dt                (tip deflection, d_ref = 1e-3 m)
+        - w_rate * (|d'| / dv_ref)^2 * dt                     (tip vibration rate, dv_ref = 1e-2 m/s)
+        - w_effort * (a / a_max)^2 * dt                       (actuator effort)
+        - w_jerk * ((a - a_prev) / a_max)^2                   (jerk, per step)
+        - w_end_stop * [end stop hit this step]
+        + bonus                                               (on success, see termination)
+Defaults: w_time = 1, w_progress = 1, w_deflection = 1, w_rate = 1, w_effort = 0.1,
+w_jerk = 0.1, w_end_stop = 10, bonus = 50.
+
+Start state
+-----------
+Static equilibrium at rest at L_start (extraction: 2 m -> target 8 m; retraction: 8 m -> 2 m,
+the paper's strokes), q = 0.  ``reset(seed=..., options=...)``: options may set ``payload`` (kg),
+``luffing_angle_deg`` (deg), ``stroke_start``, ``stroke_target`` (m).  Domain randomisation:
+``payload_range=(lo, hi)`` / ``angle_range=(lo, hi)`` draw them uniformly from
+``self.np_random`` at every reset (seeded through reset(seed)).  The ROM tables cover
+payload 20-30 t and luffing angle 60 deg only (``sim_core.modal_telescopic.allowed_ranges``);
+values outside raise ValueError.
+
+Episode end
+-----------
+* terminated (success): |L_s - L*| < tol_stroke (5 mm), |v| < tol_speed (5 mm/s),
+  |d| < tol_deflection (0.2 mm) and |d'| < tol_deflection_rate (2 mm/s); bonus added.
+* truncated: t >= t_max (30 s; also max_episode_steps = 600 of the registration), or the
+  solver failed / produced non-finite or out-of-bounds values: ``info["diverged"] = True``
+  with ``info["reason"]`` (the observation is then the last good one: never a NaN).
+
+Rendering
+---------
+``render_mode="rgb_array"``: side view (X-Z plane) of the three booms with the tip deflection
+exaggerated (``render_exaggeration``, default 500x), numpy uint8 frames (H, W, 3), drawn with
+matplotlib's Agg backend.  ``"human"`` shows the same frames in a matplotlib window.
+"""
+
+from __future__ import annotations
+
+import math
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from sim_core.errors import SimulationError
+from sim_core.modal_telescopic import ModalROM, allowed_ranges, tables_for
+from sim_core.validation.closed_form import luffing_geometry
+
+BOOM_LENGTH = 10.0          # m, SCENARIOS A1
+
+
+class TelescopicBoomEnv(gym.Env):
+    """See the module docstring for spaces, reward, start state and episode end."""
+
+    metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 20}
+
+    def __init__(self, task: str = "extraction", fidelity: str = "rl", render_mode=None,
+                 dt: float = 0.05, a_max: float = 0.25, v_max: float = 0.5,
+                 stroke_limits: tuple[float, float] | None = None, t_max: float = 30.0,
+                 payload: float = 25000.0, luffing_angle_deg: float = 60.0,
+                 payload_range: tuple[float, float] | None = None,
+                 angle_range: tuple[float, float] | None = None,
+                 n_modes: int = 3, paper_n_nodes: int = 3, paper_friction: bool = False,
+                 w_time: float = 1.0, w_progress: float = 1.0, w_deflection: float = 1.0,
+                 w_rate: float = 1.0, w_effort: float = 0.1, w_jerk: float = 0.1,
+                 w_end_stop: float = 10.0, bonus: float = 50.0,
+                 tol_stroke: float = 5e-3, tol_speed: float = 5e-3,
+                 tol_deflection: float = 2e-4, tol_deflection_rate: float = 2e-3,
+                 render_exaggeration: float = 500.0):
+        if task not in ("extraction", "retraction"):
+            raise ValueError(f"task = {task!r}: allowed 'extraction', 'retraction'")
+        if fidelity not in ("rl", "paper"):
+            raise ValueError(f"fidelity = {fidelity!r}: allowed 'rl', 'paper'")
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(f"render_mode = {render_mode!r}: allowed {self.metadata['render_modes']}")
+        for name, v in (("dt", dt), ("a_max", a_max), ("v_max", v_max), ("t_max", t_max)):
+            if not (math.isfinite(v) and v > 0):
+                raise ValueError(f"{name} = {v!r}: must be finite and > 0")
+        self.task, self.fidelity, self.render_mode = task, fidelity, render_mode
+        self.dt, self.a_max, self.v_max, self.t_max = float(dt), float(a_max), float(v_max), float(t_max)
+        (p_lo, p_hi), (ang_lo, ang_hi), (L_lo, L_hi) = allowed_ranges()
+        self._ranges = {"payload": (p_lo, p_hi), "luffing_angle_deg": (ang_lo, ang_hi)}
+        self.L_min, self.L_max = stroke_limits if stroke_limits is not None else (L_lo, L_hi)
+        if not L_lo - 1e-9 <= self.L_min < self.L_max <= L_hi + 1e-9:
+            raise ValueError(f"stroke_limits = {stroke_limits!r}: must lie within the modal "
+                             f"tables' range [{L_lo:g}, {L_hi:g}] m")
+        self.L_start0, self.L_target0 = (2.0, 8.0) if task == "extraction" else (8.0, 2.0)
+        self.payload0, self.angle0 = float(payload), float(luffing_angle_deg)
+        self.payload_range, self.angle_range = payload_range, angle_range
+        for nm, rng in (("payload", payload_range), ("luffing_angle_deg", angle_range)):
+            if rng is not None:
+                self._check_range(nm, rng[0])
+                self._check_range(nm, rng[1])
+        self._check_range("payload", self.payload0)
+        self._check_range("luffing_angle_deg", self.angle0)
+        self.n_modes, self.paper_n_nodes, self.paper_friction = n_modes, paper_n_nodes, paper_friction
+        self.w = dict(time=w_time, progress=w_progress, deflection=w_deflection, rate=w_rate,
+                      effort=w_effort, jerk=w_jerk, end_stop=w_end_stop, bonus=bonus)
+        self.tol = dict(stroke=tol_stroke, speed=tol_speed, deflection=tol_deflection,
+                        rate=tol_deflection_rate)
+        self.d_ref, self.dv_ref = 1e-3, 1e-2
+        self.exaggeration = render_exaggeration
+        self.action_space = spaces.Box(-1.0, 1.0, (1,), np.float32)
+        low = np.array([self.L_min, -v_max, -a_max, self.L_min, 0.0, -1.0, -1.0, -10.0, -10.0],
+                       np.float32)
+        high = np.array([self.L_max, v_max, a_max, self.L_max, t_max, 1.0, 1.0, 10.0, 10.0],
+                        np.float32)
+        self.observation_space = spaces.Box(low, high, dtype=np.float32)
+        self._fig = None
+        self._state = None
+
+    # -- helpers ---------------------------------------------------------------------------
+    def _check_range(self, name, value):
+        lo, hi = self._ranges[name]
+        if not (math.isfinite(value) and lo - 1e-9 <= value <= hi + 1e-9):
+            raise ValueError(f"{name} = {value!r} outside the modal tables' range [{lo:g}, {hi:g}] "
+                             "(sim_core.modal_telescopic.allowed_ranges)")
+
+    def _segments(self, L, v, a):
+        """Exact stroke kinematics over one step: list of (a_eff s^-2, duration s, dv jump at
+        its end m/s) with velocity saturation and inelastic end stops.  Returns (segments,
+        L_end, v_end, saturated, end_stop)."""
+        t_left, segs = self.dt, []
+        sat = stop = False
+        for _ in range(8):
+            if t_left <= 1e-12:
+                break
+            at_max = L >= self.L_max - 1e-12 and v >= 0
+            at_min = L <= self.L_min + 1e-12 and v <= 0
+            ae = a
+            if (v >= self.v_max - 1e-12 and a > 0) or (v <= -self.v_max + 1e-12 and a < 0):
+                ae, sat = 0.0, True
+            if (at_max and ae > 0) or (at_min and ae < 0):
+                ae = 0.0
+                stop = True
+            t_v = math.inf
+            if ae > 0:
+                t_v = (self.v_max - v) / ae
+            elif ae < 0:
+                t_v = (-self.v_max - v) / ae
+            t_s = min(_first_hit(L, v, ae, self.L_max), _first_hit(L, v, ae, self.L_min))
+            tau = min(t_left, t_v, t_s)
+            L = L + v * tau + 0.5 * ae * tau * tau
+            v = v + ae * tau
+            jump = 0.0
+            if tau == t_s and tau < t_left + 1e-15:
+                L = min(max(L, self.L_min), self.L_max)
+                jump, v, stop = -v, 0.0, True
+            elif tau == t_v:
+                v = math.copysign(self.v_max, v)
+                sat = True
+            segs.append((ae, tau, jump))
+            t_left -= tau
+        if t_left > 1e-12:                                  # pathological: hold
+            segs.append((0.0, t_left, 0.0))
+        L = min(max(L, self.L_min), self.L_max)
+        return segs, L, v, sat, stop
+
+    # -- Gymnasium API -----------------------------------------------------------------------
+    def reset(self, *, seed=None, options=None):
+        super().reset(seed=seed)
+        options = dict(options or {})
+        unknown = set(options) - {"payload", "luffing_angle_deg", "stroke_start", "stroke_target"}
+        if unknown:
+            raise ValueError(f"reset options {sorted(unknown)} unknown; allowed payload, "
+                             "luffing_angle_deg, stroke_start, stroke_target")
+        payload = self.payload0
+        angle = self.angle0
+        if self.payload_range is not None:
+            payload = float(self.np_random.uniform(*self.payload_range))
+        if self.angle_range is not None:
+            angle = float(self.np_random.uniform(*self.angle_range))
+        payload = float(options.get("payload", payload))
+        angle = float(options.get("luffing_angle_deg", angle))
+        self._check_range("payload", payload)
+        self._check_range("luffing_angle_deg", angle)
+        L0 = float(options.get("stroke_start", self.L_start0))
+        Lt = float(options.get("stroke_target", self.L_target0))
+        for nm, x in (("stroke_start", L0), ("stroke_target", Lt)):
+            if not (math.isfinite(x) and self.L_min <= x <= self.L_max):
+                raise ValueError(f"{nm} = {x!r}: allowed [{self.L_min:g}, {self.L_max:g}] m")
+        self.payload, self.angle = payload, angle
+        self.tables = tables_for(payload, angle, self.n_modes)
+        self.L_target, self.travel = Lt, max(abs(Lt - L0), 1e-3)
+        self.t, self.a_prev, self._a_applied = 0.0, 0.0, 0.0
+        self.rom = ModalROM(self.tables, L0, 0.0)
+        if self.fidelity == "paper":
+            self._paper_reset(L0)
+        self._defl = np.zeros(4)
+        self._update_deflection()
+        obs = self._obs()
+        self._last_obs = obs
+        if self.render_mode == "human":
+            self.render()
+        return obs, self._info(False, False)
+
+    def step(self, action):
+        a_in = np.asarray(action, dtype=np.float64).reshape(-1)
+        if a_in.shape != (1,):
+            raise ValueError(f"action shape {np.shape(action)}: expected (1,)")
+        if not np.all(np.isfinite(a_in)):
+            raise ValueError(f"action = {action!r} is not finite")
+        a = float(np.clip(a_in[0], -1.0, 1.0)) * self.a_max
+        segs, L1, v1, sat, stop = self._segments(self.rom.L, self.rom.v, a)
+        diverged, reason = False, ""
+        try:
+            if self.fidelity == "rl":
+                for ae, tau, jump in segs:
+                    if tau > 0:
+                        self.rom.advance(ae, tau)
+                    if jump:
+                        g = self.tables.coefficients(self.rom.L)[2]
+                        self.rom.qd = self.rom.qd - g * jump
+                        self.rom.v += jump
+            else:
+                self._paper_advance(segs)
+            self.rom.L, self.rom.v = L1, v1
+            self._update_deflection()
+            if not math.isfinite(float(self._defl.sum() + self.rom.q.sum() + self.rom.qd.sum())):
+                raise FloatingPointError("non-finite modal state")
+            dX, dZ, vX, vZ = self._defl
+            if max(abs(dX), abs(dZ)) > 1.0 or max(abs(vX), abs(vZ)) > 10.0:
+                raise FloatingPointError(f"tip deflection {self._defl} outside the observation bounds")
+        except (SimulationError, FloatingPointError, np.linalg.LinAlgError) as exc:
+            diverged, reason = True, f"{type(exc).__name__}: {exc}"
+        self.t += self.dt
+        a_applied = sum(ae * tau for ae, tau, _ in segs) / self.dt
+        d = math.hypot(self._defl[0], self._defl[1])
+        dv = math.hypot(self._defl[2], self._defl[3])
+        w = self.w
+        reward = -self.dt * (w["time"] + w["progress"] * abs(self.rom.L - self.L_target) / self.travel
+                             + w["effort"] * (a / self.a_max) ** 2)
+        if not diverged:
+            reward -= self.dt * (w["deflection"] * (d / self.d_ref) ** 2 + w["rate"] * (dv / self.dv_ref) ** 2)
+        reward -= w["jerk"] * ((a - self.a_prev) / self.a_max) ** 2 + (w["end_stop"] if stop else 0.0)
+        self.a_prev = a
+        self._a_applied = a_applied
+        settled = (not diverged and abs(self.rom.L - self.L_target) < self.tol["stroke"]
+                   and abs(self.rom.v) < self.tol["speed"] and d < self.tol["deflection"]
+                   and dv < self.tol["rate"])
+        if settled:
+            reward += w["bonus"]
+        truncated = diverged or self.t >= self.t_max - 1e-9
+        if diverged:
+            obs = self._last_obs
+        else:
+            obs = self._obs()
+            self._last_obs = obs
+        info = self._info(sat, stop)
+        info.update(diverged=diverged, reason=reason, success=settled)
+        if self.render_mode == "human":
+            self.render()
+        return obs, float(reward), bool(settled), bool(truncated), info
+
+    def _obs(self):
+        a = self._a_applied
+        o = np.array([self.rom.L, self.rom.v, a, self.L_target, max(self.t_max - self.t, 0.0),
+                      *self._defl], dtype=np.float64)
+        return np.clip(o, self.observation_space.low, self.observation_space.high).astype(np.float32)
+
+    def _info(self, sat, stop):
+        return {"time": self.t, "stroke": self.rom.L, "stroke_rate": self.rom.v,
+                "velocity_saturated": bool(sat), "end_stop": bool(stop),
+                "tip_deflection": self._defl[:2].copy(), "payload": self.payload,
+                "luffing_angle_deg": self.angle, "fidelity": self.fidelity,
+                "diverged": False, "reason": ""}
+
+    def _update_deflection(self):
+        """self._defl = (dX, dZ, dX', dZ') of the tip relative to the static tip at L_s (m, m/s)."""
+        if self.fidelity == "rl":
+            self._defl = np.array(self.rom.deflection())
+            return
+        else:
+            r, v = self._paper_tip()
+            rs, drs = self.tables.static_tip(self.rom.L)
+            d, dv = r - rs - self._tip_offset, v - drs * self.rom.v
+        self._defl = np.array([d[0], d[2], dv[0], dv[2]], dtype=np.float64)
+
+    # -- paper fidelity -----------------------------------------------------------------------
+    def _paper_reset(self, L0):
+        from dataclasses import replace
+
+        from sim_core.telescopic import TelescopicParams, build_telescopic, initial_equilibrium
+        p = replace(TelescopicParams(), payload=self.payload, luffing_angle_deg=self.angle,
+                    stroke0=L0, n_nodes=self.paper_n_nodes, friction=self.paper_friction)
+        self._ts = build_telescopic(p)
+        z, _ = initial_equilibrium(self._ts)
+        self._y = np.concatenate([z, np.zeros_like(z)])
+        self._cyl = next(c for c in self._ts.model.nonlinear if c.name == "telescopic_cylinder")
+        self._kin = (L0, 0.0, [])
+        self._cyl.target = self._target
+        # deflection reference: the model's own equilibrium tip at the start, moved with the
+        # tables' static tip (the tables interpolate across the retraction rope's slack/taut
+        # switch near L_s = 2 m: ~1 mm off there, more than the dynamic response)
+        self._tip_offset = self._paper_tip()[0] - self.tables.static_tip(L0)[0]
+
+    def _target(self, t):
+        """Cylinder length, rate, acceleration at local time t (s) of the current step."""
+        L, v, segs = self._kin
+        for ae, tau, jump in segs:
+            if t <= tau:
+                return (L + v * t + 0.5 * ae * t * t, v + ae * t, ae)
+            L, v, t = L + v * tau + 0.5 * ae * tau * tau, v + ae * tau + jump, t - tau
+        return (L + v * t, v, 0.0)
+
+    def _paper_advance(self, segs):
+        from sim_core.simulate import integrate_rk45
+        self._kin = (self.rom.L, self.rom.v, segs)
+        _, ys, _ = integrate_rk45(self._ts.model, self._y, self.dt,
+                                  {"rtol": 1e-6, "atol": 1e-7, "n_output": 2})
+        self._y = ys[-1]
+
+    def _paper_tip(self):
+        m = self._ts.model
+        n = m.n_dof
+        Q, Qd = m.full_state(0.0, self._y[:n], self._y[n:])
+        r, J, _, _ = self._ts.tip(Q)
+        return np.real(r), np.real(J @ Qd)
+
+    # -- rendering ---------------------------------------------------------------------------
+    def render(self):
+        if self.render_mode is None:
+            gym.logger.warn("render() called without render_mode; set render_mode='rgb_array' or 'human'")
+            return None
+        frame = self._draw()
+        if self.render_mode == "rgb_array":
+            return frame
+        import matplotlib.pyplot as plt
+        if getattr(self, "_human", None) is None:
+            plt.ion()
+            self._human = plt.figure("boom_env")
+            self._human_im = self._human.add_subplot(111).imshow(frame)
+            self._human.axes[0].axis("off")
+        else:
+            self._human_im.set_data(frame)
+        plt.pause(1.0 / self.metadata["render_fps"])
+        return None
+
+    def _draw(self):
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
+        if self._fig is None:
+            self._fig = Figure(figsize=(4.8, 3.6), dpi=100)
+            FigureCanvasAgg(self._fig)
+            self._ax = self._fig.add_subplot(111)
+        ax = self._ax
+        ax.clear()
+        geo = luffing_geometry(math.radians(self.angle))
+        O, e = np.asarray(geo.origin)[[0, 2]], np.asarray(geo.e_s)[[0, 2]]
+        L = self.rom.L
+        d = self.exaggeration * self._defl[:2]
+        total = 2 * L + BOOM_LENGTH
+        for k, (col, lw) in enumerate((("tab:blue", 7), ("tab:orange", 5), ("tab:green", 3))):
+            s = np.linspace(k * L, k * L + BOOM_LENGTH, 20)
+            x = s / total
+            shape = 0.5 * x * x * (3 - x)          # cantilever-like interpolation of the tip deflection
+            pts = O[None] + s[:, None] * e[None] + shape[:, None] * d[None]
+            ax.plot(pts[:, 0], pts[:, 1], color=col, lw=lw, solid_capstyle="butt")
+        tip = O + total * e + d
+        ax.plot(*tip, "ks", ms=8)
+        tgt = O + (2 * self.L_target + BOOM_LENGTH) * e
+        ax.plot(*tgt, "r+", ms=12)
+        ax.set_xlim(-2, 16)
+        ax.set_ylim(-1, 26)
+        ax.set_aspect("equal")
+        ax.set_title(f"t = {self.t:5.2f} s  L_s = {L:5.3f} m  |d| = {1e3 * math.hypot(*self._defl[:2]):.2f} mm"
+                     f" (x{self.exaggeration:g})", fontsize=8)
+        ax.set_xlabel("X (m)", fontsize=8)
+        ax.set_ylabel("Z (m)", fontsize=8)
+        self._fig.canvas.draw()
+        buf = np.asarray(self._fig.canvas.buffer_rgba())
+        return np.ascontiguousarray(buf[:, :, :3]).astype(np.uint8)
+
+    def close(self):
+        if getattr(self, "_human", None) is not None:
+            import matplotlib.pyplot as plt
+            plt.close(self._human)
+            self._human = None
+        self._fig = None
+
+
+def _first_hit(L, v, a, stop):
+    """Smallest t > 0 with L + v t + a t^2 / 2 = stop moving towards it (inf if never)."""
+    if (stop > L and v <= 0 and a <= 0) or (stop < L and v >= 0 and a >= 0) or stop == L:
+        return math.inf
+    if abs(a) < 1e-15:
+        return (stop - L) / v if v != 0 else math.inf
+    disc = v * v + 2 * a * (stop - L)
+    if disc < 0:
+        return math.inf
+    r = math.sqrt(disc)
+    roots = [t for t in ((-v - r) / a, (-v + r) / a) if t > 1e-15]
+    return min(roots) if roots else math.inf
