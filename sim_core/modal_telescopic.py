@@ -399,11 +399,12 @@ class ModalROM:
 
 def check_params(p) -> None:
     """Raise ValueError if TelescopicParams p differ from the table build in anything the ROM
-    does not interpolate (only payload, luffing angle, stroke history and n_nodes may vary)."""
+    does not interpolate (only payload, luffing angle, stroke history and n_nodes may vary;
+    contact_distribution acts on outputs only when friction is off)."""
     from .telescopic import TelescopicParams
     ref = TelescopicParams()
     for k in ("n_booms", "boom_length", "L_h", "E", "rho", "rope_EA", "gravity", "filter_h",
-              "sections", "torsion", "rope_elasticity", "flexible", "contact_distribution"):
+              "sections", "torsion", "rope_elasticity", "flexible"):
         if not hasattr(ref, k):             # options of later sim_core versions
             continue
         if getattr(p, k) != getattr(ref, k):
