@@ -134,7 +134,14 @@ def _plots(result: Result, out: Path) -> list:
         print("boom-sim: warning: matplotlib is not installed, figures skipped", file=sys.stderr)
         return []
     from .plots import plot_result
-    return plot_result(result, out)
+    return plot_result(result, out) + _folding_plots(result, out)
+
+
+def _folding_plots(result: Result, out: Path) -> list:
+    if result.scene.get("kind") != "folding" and result.scene.get("name") != "folding":
+        return []
+    from .folding_plots import plot_folding
+    return plot_folding(result, out)
 
 
 def cmd_list(args) -> int:
@@ -151,6 +158,10 @@ def cmd_describe(args) -> int:
         from .telescopic import build_telescopic
         from .telescopic_scene import params_from_scene
         model = build_telescopic(params_from_scene(scene)).model
+    elif scene.get("kind") == "folding":
+        from .folding import build_folding
+        from .folding_scene import params_from_scene as folding_params
+        model = build_folding(folding_params(scene)).model
     else:
         model, _, _ = build_model(scene)
     print(f"scene {scene['name']}: {scene['description']}")
@@ -177,7 +188,7 @@ def cmd_plot(args) -> int:
     except ImportError:
         raise _InputError("matplotlib is not installed (pip install matplotlib)") from None
     from .plots import plot_result
-    figs = plot_result(res, out)
+    figs = plot_result(res, out) + _folding_plots(res, out)
     print(f"wrote {len(figs)} figures to {out}")
     return 0
 
