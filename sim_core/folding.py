@@ -145,6 +145,18 @@ class FoldingParams:
                 mk(self.cyl2_stroke, s2))
 
 
+def _sampler(profile):
+    """t -> (s, v, a) of a profile with the last time cached (the RHS asks several times)."""
+    last = [None, None]
+
+    def f(t):
+        if last[0] != t:
+            smp = profile.sample(float(t))
+            last[:] = [t, (smp.s, smp.v, smp.a)]
+        return last[1]
+    return f
+
+
 # -- closed-form linkage geometry in the luffing plane -------------------------------------------
 
 def _rot2(v, a):
@@ -272,10 +284,10 @@ def build_folding(p: FoldingParams) -> FoldingSystem:
            for ib in range(2) for end in ("left", "right")]
     profs = p.profiles()
     if p.slew_prescribed:
-        sp = profs[1]
-        lin.append(LinearConstraint("slew", [{i_phi: 1.0}], lambda t: np.array([sp.stroke(t)]),
-                                    lambda t: np.array([sp.rate(t)]),
-                                    lambda t: np.array([sp.accel(t)])))
+        sp = _sampler(profs[1])
+        lin.append(LinearConstraint("slew", [{i_phi: 1.0}], lambda t: np.array([sp(t)[0]]),
+                                    lambda t: np.array([sp(t)[1]]),
+                                    lambda t: np.array([sp(t)[2]])))
     zero = lambda t: np.zeros(1)
     for cyl in ("1", "2"):   # prismatic joints: theta_rod = theta_barrel (linear)
         lin.append(LinearConstraint(f"prismatic{cyl}_angle",
@@ -382,9 +394,9 @@ def build_folding(p: FoldingParams) -> FoldingSystem:
     for cyl, s0, prof in (("1", s1_0, profs[0]), ("2", s2_0, profs[2])):
         a, b = frames["barrel" + cyl], frames["rod" + cyl]
         if p.rigid_cylinders:
+            smp = _sampler(prof)
             cons.append(distance_driver(f"cylinder{cyl}", b, a,
-                                        lambda t, s0=s0, pr=prof: (s0 + pr.stroke(t), pr.rate(t),
-                                                                   pr.accel(t))))
+                                        lambda t, s0=s0, f=smp: (s0 + f(t)[0], f(t)[1], f(t)[2])))
             cyls.append(None)
         else:
             act = SpringDamperActuator(a, b, p.k, p.c, s0, prof, name=f"cylinder{cyl}")

@@ -66,6 +66,11 @@ def _cross_cols(a: np.ndarray, W: np.ndarray) -> np.ndarray:
                      W[0] * a[1] - W[1] * a[0]])
 
 
+def _cross3(a, b):
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                     a[0] * b[1] - a[1] * b[0]])
+
+
 def rot_axis(axis: np.ndarray, angle) -> np.ndarray:
     """Rotation matrix by ``angle`` (rad, complex allowed) about the unit vector ``axis``."""
     a = np.asarray(axis, float) / np.linalg.norm(axis)
@@ -90,7 +95,7 @@ def turntable_frame(n_coords: int, i_phi: int, slew_axis, plane_basis, point=(0.
         r = R @ p
         J = np.zeros((3, n_coords), dtype=np.result_type(phi, float))
         W = np.zeros((3, n_coords))
-        J[:, i_phi] = np.cross(ax, r)
+        J[:, i_phi] = _cross3(ax, r)
         W[:, i_phi] = ax
         return r, J, R, W.astype(J.dtype)
     return _memo(fun)
@@ -119,7 +124,7 @@ def planar_body_frame(n_coords: int, i_phi: int, i_body: int, slew_axis, plane_b
         J[:, iu] = S[:, 0]
         J[:, iv] = S[:, 1]
         J[:, it] = S @ (dRz @ p)
-        J[:, i_phi] = np.cross(ax, r)
+        J[:, i_phi] = _cross3(ax, r)
         W[:, i_phi] = ax
         W[:, it] = S[:, 2]
         return r, J, S @ Rz, W
@@ -187,7 +192,7 @@ class RigidBody:
         f = -self.mass * acc
         if self.gravity is not None:
             f = f + self.mass * np.asarray(self.gravity, float)
-        F += J.T @ f - W.T @ (Ig @ wdot + np.cross(om, Ig @ om))
+        F += J.T @ f - W.T @ (Ig @ wdot + _cross3(om, Ig @ om))
 
     def momentum(self, Q, Qd, point=np.zeros(3)):
         """Linear momentum (kg m/s) and angular momentum about ``point`` (kg m^2/s)."""
@@ -247,7 +252,10 @@ class SpringDamperActuator:
     def reference(self, t):
         if self.profile is None:
             return self.s_ref0, 0.0
-        return self.s_ref0 + float(self.profile.stroke(t)), float(self.profile.rate(t))
+        if getattr(self, "_last_t", None) != t:
+            smp = self.profile.sample(float(t))
+            self._last_t, self._last = t, (float(smp.s), float(smp.v))
+        return self.s_ref0 + self._last[0], self._last[1]
 
     def tension(self, t, Q, Qd):
         s, g = self.length(Q)
@@ -273,7 +281,7 @@ def planar_pin(name: str, fa, fb, plane_frame) -> NonlinearConstraint:
         E = R[:, :2]
         g = E.T @ d
         # dE/dQ_j = W_j x E  ->  d/dQ_j (E_k . d) = (W_j x E_k) . d = W_j . (E_k x d)
-        J = E.T @ (Ja - Jb) + np.stack([np.cross(E[:, k], d) @ W for k in range(2)])
+        J = E.T @ (Ja - Jb) + np.stack([_cross3(E[:, k], d) @ W for k in range(2)])
         return g, J
     return NonlinearConstraint(name, 2, evaluate)
 
@@ -292,7 +300,7 @@ def revolute_axis(name: str, fa, fb, c_a, p_b, q_b) -> NonlinearConstraint:
         for w in (p_b, q_b):
             u = Rb @ w
             g.append(u @ n)
-            J.append(np.cross(u, n) @ (Wb - Wa))
+            J.append(_cross3(u, n) @ (Wb - Wa))
         return np.array(g), np.vstack(J)
     return NonlinearConstraint(name, 2, evaluate)
 
@@ -307,5 +315,5 @@ def prismatic_offset(name: str, fa, fb, axis_normal_a) -> NonlinearConstraint:
         rb, Jb, _, _ = fb(Q)
         e = Ra @ m_a
         d = rb - ra
-        return np.atleast_1d(d @ e), (e @ (Jb - Ja) + np.cross(e, d) @ Wa)[None, :]
+        return np.atleast_1d(d @ e), (e @ (Jb - Ja) + _cross3(e, d) @ Wa)[None, :]
     return NonlinearConstraint(name, 1, evaluate)
