@@ -125,8 +125,8 @@ def test_constraint_violation_bound(rigid_run):
 # ---------------------------------------------------------------------------------------------
 # angular momentum about the slew axis with zero drive torque
 # ---------------------------------------------------------------------------------------------
-def _free_slew_run(rtol):
-    p = FoldingParams(n_nodes=3, gravity=9.81, rest_k=0.0, filter_h=0.005, E=2.11e12,
+def _free_slew_run(rtol, n_nodes=3):
+    p = FoldingParams(n_nodes=n_nodes, gravity=9.81, rest_k=0.0, filter_h=0.005, E=2.11e12,
                       slew_prescribed=False, stage_starts=(100.0, 100.0, 100.0), c=0.0)
     fs = build_folding(p)
     m = fs.model
@@ -134,7 +134,7 @@ def _free_slew_run(rtol):
     # impulsive torque on the turntable: the velocity after the impulse minimises kinetic
     # energy subject to the velocity constraints -> M-orthogonal projection of phi_dot
     Qd_g = np.zeros(m.n_coords)
-    Qd_g[fs.i_phi] = 0.3
+    Qd_g[fs.i_phi] = 6.0         # -> ~0.2 rad/s after the projection (booms dominate I_X)
     _, zd_g = m.reduced_state(0.0, fs.Q0, Qd_g)
     Q, Qd = m.full_state(0.0, z0, zd_g)
     M, _ = m.mass_force(0.0, Q, Qd)
@@ -155,15 +155,30 @@ def free_slew():
 
 
 def test_angular_momentum_conserved_without_drive_torque(free_slew):
-    """H . X is a first integral (gravity along X, joints and cylinders internal, Baumgarte
-    forces are constraint forces C^T lambda, hence torque-free about the symmetry axis).  The
-    drift is integration error only, so it must shrink with rtol (convergence study) and be
-    below 10 rtol relative at the tighter tolerance."""
+    """H . X is a first integral of the continuous model (gravity along X, joints and cylinders
+    internal, Baumgarte forces are constraint forces C^T lambda of rotation-invariant rows).
+
+    Convergence study (recorded): relative drift over 0.5 s at rtol 1e-6 is 1.84e-5 with 2
+    sub-elements per boom and 3.0e-6 with 4 (test_angular_momentum_mesh_convergence, slow), and
+    the same at rtol 1e-4 and 1e-6: the drift is the space discretization's (the interpolated
+    Cardan torsion field is not exactly objective under a rigid rotation), not the
+    integrator's.  Checks: the drift does not depend on rtol (integration error < 10 % of it)
+    and stays below 1e-4 (5x the measured 2-sub-element value) at this mesh."""
     drift = {}
     for rtol, res in free_slew.items():
         Hx = res["angular_momentum"][:, 0]
         assert abs(Hx[0]) > 1e3                        # the turntable really spins
         drift[rtol] = np.max(np.abs(Hx - Hx[0])) / abs(Hx[0])
         assert np.max(np.abs(res["slew_angle"])) > 0.05
-    assert drift[1e-6] < 10 * 1e-6, drift
-    assert drift[1e-6] < drift[1e-4] or drift[1e-4] < 10 * 1e-6, drift
+    assert drift[1e-6] < 1e-4, drift
+    assert abs(drift[1e-4] - drift[1e-6]) < 0.1 * drift[1e-6], drift
+
+
+@pytest.mark.slow
+def test_angular_momentum_mesh_convergence(free_slew):
+    """The drift shrinks with mesh refinement (2 -> 4 sub-elements: expected ~6x, assert 2x)."""
+    res3 = free_slew[1e-6]
+    res5 = _free_slew_run(1e-6, n_nodes=5)
+    d = [np.max(np.abs(r["angular_momentum"][:, 0] - r["angular_momentum"][0, 0]))
+         / abs(r["angular_momentum"][0, 0]) for r in (res3, res5)]
+    assert d[1] < 0.5 * d[0], d
