@@ -90,8 +90,6 @@ def test_rigid_limit_tip_follows_linkage(rigid_run):
     """
     p, res = rigid_run
     prof = p.profiles()
-    s1_0, s2_0 = closed_form_s0 = (np.hypot(2.5, 1.05), None)
-    del closed_form_s0
     fs = build_folding(p)
     s1_0, s2_0 = fs.s_retracted
     ts = res.t
