@@ -87,6 +87,8 @@ def test_rigid_limit_tip_follows_linkage(rigid_run):
     largest boom-2 tip acceleration of the closed-form motion (finite differences) plus the
     hinge/links rigid, bound = m' a_max L^4 / EI.  The filter (h = 0.005 s) lags the stress by
     ~h/2 -> adds h/2 * |v_tip| * (strain rate / strain) -- negligible in the quasi-static limit.
+    Measured (E x 1000, 1 s, 3 stages overlapped): error 1.5e-3 m, bound 3.2e-3 m, tip motion
+    2.6 m.
     """
     p, res = rigid_run
     prof = p.profiles()
@@ -113,7 +115,8 @@ def test_rigid_limit_tip_follows_linkage(rigid_run):
 def test_constraint_violation_bound(rigid_run):
     """Baumgarte (xi1 = xi2 = 10 1/s) keeps |Phi| at the level of the integrator's position
     error: each step adds at most ~(rtol |q| + atol) with |q| <= 2 L; errors decay with the
-    time constant 1/xi = 0.1 s, so |Phi| <= (steps per 0.1 s) (rtol 2L + atol)."""
+    time constant 1/xi = 0.1 s, so |Phi| <= (steps per 0.1 s) (rtol 2L + atol).
+    Measured: max |Phi| = 4.1e-6 against the bound 1.0e-3 (434 steps in 1 s)."""
     p, res = rigid_run
     steps_per_tau = res.stats["n_steps"] / T_RIGID * 0.1
     tol = steps_per_tau * (1e-6 * 2 * p.boom_length + 1e-8)
