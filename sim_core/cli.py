@@ -134,7 +134,14 @@ def _plots(result: Result, out: Path) -> list:
         print("boom-sim: warning: matplotlib is not installed, figures skipped", file=sys.stderr)
         return []
     from .plots import plot_result
-    return plot_result(result, out)
+    return plot_result(result, out) + _folding_plots(result, out)
+
+
+def _folding_plots(result: Result, out: Path) -> list:
+    if result.scene.get("kind") != "folding" and result.scene.get("name") != "folding":
+        return []
+    from .folding_plots import plot_folding
+    return plot_folding(result, out)
 
 
 def cmd_list(args) -> int:
@@ -166,6 +173,10 @@ def cmd_describe(args) -> int:
         model = ts.model
         if ts.contact is not None and not params.friction:
             print("note: slider-spring distribution evaluated for the outputs only (friction off)")
+    elif scene.get("kind") == "folding":
+        from .folding import build_folding
+        from .folding_scene import params_from_scene as folding_params
+        model = build_folding(folding_params(scene)).model
     else:
         model, _, _ = build_model(scene)
     print(f"scene {scene['name']}: {scene['description']}")
@@ -192,7 +203,7 @@ def cmd_plot(args) -> int:
     except ImportError:
         raise _InputError("matplotlib is not installed (pip install matplotlib)") from None
     from .plots import plot_result
-    figs = plot_result(res, out)
+    figs = plot_result(res, out) + _folding_plots(res, out)
     print(f"wrote {len(figs)} figures to {out}")
     return 0
 

@@ -431,4 +431,7 @@ def load_scene(name_or_path: str | Path, overrides: dict[str, Any] | None = None
     if raw.get("kind") == "telescopic":
         from .telescopic_scene import validate_telescopic
         return validate_telescopic(raw, source)
+    if raw.get("kind") == "folding":
+        from .folding_scene import validate_folding
+        return validate_folding(raw, source)
     return validate(raw, source)

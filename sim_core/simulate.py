@@ -137,6 +137,14 @@ def simulate(scene: dict, progress=None) -> Result:
                                   sol["rtol"], sol["atol"], progress)
         res.scene = scene
         return res
+    if scene.get("kind") == "folding":
+        from .folding import simulate_folding
+        from .folding_scene import params_from_scene as folding_params
+        sol = scene["solver"]
+        res = simulate_folding(folding_params(scene), sol["t_end"], sol["n_output"],
+                               sol["rtol"], sol["atol"], progress, sol.get("max_step"))
+        res.scene = scene
+        return res
     model, Q0, Qd0 = build_model(scene)
     sol = scene["solver"]
     z0, zd0 = model.reduced_state(0.0, Q0, Qd0)
