@@ -95,20 +95,40 @@ def beam_model(n_sub: int, filter_h: float):
     return model, z0, zd0
 
 
+BUDGET = [20.0]          # s of process time per run; exceeded -> row status "budget"
+
+
+class _Budget:
+    """SecondOrderSystem proxy that aborts a run after BUDGET[0] s of process time."""
+
+    def __init__(self, system):
+        self.system, self.n, self.t0 = system, system.n, time.process_time()
+
+    def check(self, t):
+        if time.process_time() - self.t0 > BUDGET[0]:
+            raise SimulationError(t, f"budget {BUDGET[0]:g} s exceeded")
+
+    def mass_and_force(self, t, q, v):
+        self.check(t)
+        return self.system.mass_and_force(t, q, v)
+
+
 def run_integrator(integrator, system_for_implicit, rk_model, z0, zd0, t_end, rtol, t_eval):
     """-> (q at t_eval (k, n), stats dict).  atol = rtol * 1e-3 (m, rad; m/s, rad/s)."""
     atol = 1e-3 * rtol
     n = z0.size
     if integrator == "RK45":
+        b = _Budget(system_for_implicit)
         t, ys, st = integrate_rk45(rk_model, np.concatenate([z0, zd0]), t_end,
-                                   {"rtol": rtol, "atol": atol, "n_output": len(t_eval)})
+                                   {"rtol": rtol, "atol": atol, "n_output": len(t_eval)},
+                                   progress=lambda t, w: b.check(t))
         return ys[:, :n], {"n_steps": st["n_steps"], "n_evals": st["n_rhs"], "n_jac": 0,
                            "n_rejected": None}
     if integrator == "GA":
-        r = integrate_generalized_alpha(system_for_implicit, (0.0, t_end), z0, zd0, rho_inf=0.8,
+        r = integrate_generalized_alpha(_Budget(system_for_implicit), (0.0, t_end), z0, zd0, rho_inf=0.8,
                                         rtol=rtol, atol=atol, t_eval=t_eval)
     else:
-        r = integrate_scipy(system_for_implicit, (0.0, t_end), z0, zd0, method=integrator,
+        r = integrate_scipy(_Budget(system_for_implicit), (0.0, t_end), z0, zd0, method=integrator,
                             rtol=rtol, atol=atol, t_eval=t_eval)
     s = r.stats
     return r.q, {"n_steps": s.n_steps, "n_evals": s.n_force_evaluations,
@@ -131,7 +151,7 @@ def beam_run(n_sub, integrator, rtol, filter_h, t_eval):
         q, st = run_integrator(integrator, model, model, z0, zd0, t_end, rtol, t_eval)
         row["status"] = "ok"
     except SimulationError as exc:
-        row.update(status=f"failed: {str(exc)[:60]}", wall_s=time.process_time() - w0)
+        row.update(status=("budget" if "budget" in str(exc) else "failed") + f": t={exc.t:.3g} s", wall_s=time.process_time() - w0)
         return row, None
     wall = time.process_time() - w0
     row.update(st, wall_s=wall, wall_per_sim_s=wall / t_end)
@@ -145,26 +165,38 @@ def part_beam(quick: bool, out_rows: list):
     peak = float(np.max(np.abs(w_fryba)))
     print(f"[beam] Fryba alpha={ALPHA}: c = {c:.3f} m/s, crossing {t_end:.4f} s, "
           f"peak midspan {peak * 1e3:.3f} mm", flush=True)
-    ref_row, w_ref = beam_run(16, "Radau", 1e-10, 0.0, t_eval)
-    print(f"  reference (16 sub, Radau 1e-10): {ref_row['wall_s']:.1f} s, "
-          f"err vs Fryba {np.max(np.abs(w_ref - w_fryba)):.3e} m", flush=True)
+    # Without the stress filter the axial / high bending modes of the quintic splines make
+    # RK45 stability-limited (h ~ 1e-5 s) and the implicit error test resolve them: the filter
+    # (h^2/6) K mass caps the highest frequency near sqrt(6)/h (second seed, Eq. 53), so the
+    # reference is a small-h filtered run; its filter error shows in the h sweep.
+    BUDGET[0] = 120.0 if quick else 1200.0
+    ref_n, ref_h, ref_r = (8, 3e-4, 1e-7) if quick else (16, 1e-4, 1e-9)
+    ref_row, w_ref = beam_run(ref_n, "RK45", ref_r, ref_h, t_eval)
+    if w_ref is None:
+        raise SystemExit(f"beam reference failed: {ref_row}")
+    print(f"  reference ({ref_n} sub, RK45 rtol {ref_r:g}, h {ref_h:g} s): "
+          f"{ref_row['wall_s']:.1f} s, err vs Fryba {np.max(np.abs(w_ref - w_fryba)):.3e} m",
+          flush=True)
+    ref_row.update(peak_m=peak, err_closed_m=float(np.max(np.abs(w_ref - w_fryba))),
+                   err_ref_m=0.0, case="beam_fryba_REFERENCE")
+    out_rows.append(ref_row)
+    BUDGET[0] = 15.0 if quick else 300.0
     configs = []
-    subs = (2, 4, 8, 16)
-    rtols = (1e-3, 1e-5, 1e-7) if quick else (1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8)
-    for ig in ("RK45", "GA", "Radau"):
-        for r in rtols:
-            configs.append((4, ig, r, 0.0))
-    for n in subs:
-        if n != 4:
-            configs.append((n, "Radau", 1e-7, 0.0))
-            configs.append((n, "RK45", 1e-5, 0.0))
-    for h in ((1e-3, 1e-2) if quick else (1e-4, 1e-3, 3e-3, 1e-2)):
+    h0 = 1e-3
+    for r in ((1e-3, 1e-5, 1e-7) if quick else (1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8)):
+        configs.append((4, "RK45", r, h0))
+    for ig in ("GA", "Radau"):
+        for r in ((1e-3, 1e-4) if quick else (1e-2, 1e-3, 1e-4, 1e-5, 1e-6)):
+            configs.append((4, ig, r, h0))
+        configs.append((4, ig, 1e-3, 0.0))                   # unfiltered: implicit only
+    for n in ((2, 8) if quick else (2, 8, 16)):
+        configs.append((n, "RK45", 1e-5, h0))
+        configs.append((n, "GA", 1e-4, h0))
+    for h in ((3e-4, 3e-3, 1e-2) if quick else (1e-4, 3e-4, 3e-3, 1e-2)):
         configs.append((4, "RK45", 1e-5, h))
-        configs.append((4, "Radau", 1e-7, h))
     if not quick:
-        for n in (8, 16):
-            for ig in ("GA", "BDF"):
-                configs.append((n, ig, 1e-6, 0.0))
+        configs.append((4, "BDF", 1e-4, h0))
+        configs.append((4, "RK45", 1e-5, 0.0))               # unfiltered explicit
     for n, ig, r, h in configs:
         row, w = beam_run(n, ig, r, h, t_eval)
         row["peak_m"] = peak
@@ -214,7 +246,7 @@ def tele_run(case, n_sub, integrator, rtol, filter_h, T):
                                np.array([0.0, T]))
         row["status"] = "ok"
     except SimulationError as exc:
-        row.update(status=f"failed: {str(exc)[:60]}", wall_s=time.process_time() - w0)
+        row.update(status=("budget" if "budget" in str(exc) else "failed") + f": t={exc.t:.3g} s", wall_s=time.process_time() - w0)
         return row, None
     wall = time.process_time() - w0
     row.update(st, wall_s=wall, wall_per_sim_s=wall / T)
@@ -224,6 +256,7 @@ def tele_run(case, n_sub, integrator, rtol, filter_h, T):
 
 def part_telescopic(quick: bool, out_rows: list):
     T = 0.2 if quick else 1.0
+    BUDGET[0] = 60.0 if quick else 900.0
     cases = ("rigid_9.1", "flexible_25t")
     for case in cases:
         subs = (2, 4) if quick else (2, 4, 8)
