@@ -254,8 +254,9 @@ def tele_run(case, n_sub, integrator, rtol, filter_h, T):
     return row, ts.tip(Q)[0]
 
 
-def part_telescopic(quick: bool, out_rows: list):
-    T = 0.2 if quick else 1.0
+def part_telescopic(quick: bool, out_rows: list, window: float | None = None,
+                    subs_override: tuple | None = None):
+    T = window if window else (0.2 if quick else 1.0)
     BUDGET[0] = 60.0 if quick else 900.0
     cases = ("rigid_9.1", "flexible_25t")
     for case in cases:
@@ -263,6 +264,8 @@ def part_telescopic(quick: bool, out_rows: list):
         hs = (0.01, 0.03) if quick else (0.003, 0.01, 0.03)
         if quick and case == "flexible_25t":
             subs = (2,)
+        if subs_override:
+            subs = subs_override
         ref_sub, ref_h = subs[-1], hs[0]
         print(f"[telescopic {case}] window {T} s; reference n_sub={ref_sub} h={ref_h} "
               f"RK45 rtol 1e-9", flush=True)
@@ -352,6 +355,11 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="reduced sweep (< 5 min)")
     ap.add_argument("--part", choices=("beam", "telescopic", "all"), default="all")
+    ap.add_argument("--window", type=float, default=None,
+                    help="telescopic window T (s); default 0.2 (quick) / 1.0 (full)")
+    ap.add_argument("--subs", type=str, default=None,
+                    help="telescopic sub-element sweep, e.g. 2,4 (last = reference mesh)")
+    ap.add_argument("--tag", type=str, default="", help="suffix of the telescopic output files")
     args = ap.parse_args()
     os.makedirs(RESULTS, exist_ok=True)
     stamp = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
@@ -369,9 +377,12 @@ def main():
               ("err_ref_m", "max error vs converged reference (m)")])
     if args.part in ("telescopic", "all"):
         rows = []
-        part_telescopic(args.quick, rows)
-        write_csv(rows, os.path.join(RESULTS, "work_precision_telescopic.csv"), header)
-        plot(rows, os.path.join(RESULTS, "work_precision_telescopic.png"),
+        subs = tuple(int(x) for x in args.subs.split(",")) if args.subs else None
+        part_telescopic(args.quick, rows, args.window, subs)
+        tag = f"_{args.tag}" if args.tag else ""
+        write_csv(rows, os.path.join(RESULTS, f"work_precision_telescopic{tag}.csv"),
+                  header + (f"; window {args.window} s, sub-elements {args.subs}" if tag else ""))
+        plot(rows, os.path.join(RESULTS, f"work_precision_telescopic{tag}.png"),
              "Telescopic extraction, tip position error at T; " + header,
              [("err_ref_m", "tip position error vs reference (m)")])
     print(f"total {time.perf_counter() - t0:.0f} s (wall clock)")
