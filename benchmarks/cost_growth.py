@@ -1,0 +1,126 @@
+"""Cost growth of the telescopic model (issue 5): wall time per simulated second vs the number
+of sub-elements per spline element and vs the number of booms, with log-log fitted exponents.
+
+One command (repository root), ~2-4 min:
+
+    OPENBLAS_NUM_THREADS=1 PYTHONPATH=. python benchmarks/cost_growth.py
+
+Writes benchmarks/results/cost_growth.csv and cost_growth.png.
+
+Per configuration (case 9.1 stiffness, E = 2.1e12 Pa, 1 t payload, no friction, filter
+h = 0.01 s; ``TelescopicParams(n_booms=N, n_nodes=n_sub + 1)``):
+
+* ``rhs_ms``: one ``model.rhs`` (KKT solve), best of 5 repeats of 3 calls (process time);
+* an RK45 run (rtol 1e-5, atol 1e-6) over a window of T = 0.1 s **from the straight initial
+  configuration** (the static equilibrium costs 10-60 s per model and is skipped here): steps,
+  RHS evaluations, and ``wall_per_sim_s`` = process time / T.  With the filter on, RK45 is
+  stability-limited (step ~ 1.3 h, the filter mass (h^2/6) K caps the highest frequency near
+  sqrt(6)/h; second seed Eq. 53), so steps per simulated second hardly depend on the mesh or the
+  number of booms and the growth is that of one RHS.
+
+Fitted exponent p of cost ~ x^p: least squares of log(cost) on log(x).
+"""
+
+from __future__ import annotations
+
+import csv
+import datetime
+import os
+import sys
+import time
+
+if os.environ.get("OPENBLAS_NUM_THREADS") != "1":
+    print("warning: run with OPENBLAS_NUM_THREADS=1 for comparable numbers", file=sys.stderr)
+
+import numpy as np
+
+sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..")))
+
+from sim_core.simulate import integrate_rk45                                       # noqa: E402
+from sim_core.telescopic import TelescopicParams, build_telescopic                 # noqa: E402
+
+RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
+FIELDS = ["sweep", "n_booms", "n_sub", "n_dof", "rhs_ms", "t_sim", "n_steps", "n_rhs", "wall_s",
+          "wall_per_sim_s", "status"]
+T = 0.1
+
+
+def measure(n_booms: int, n_sub: int, sweep: str) -> dict:
+    p = TelescopicParams(n_booms=n_booms, n_nodes=n_sub + 1, E=2.1e12, payload=1000.0,
+                         friction=False, filter_h=0.01)
+    ts = build_telescopic(p)
+    m = ts.model
+    z0, zd0 = m.reduced_state(0.0, ts.Q0, np.zeros_like(ts.Q0))
+    y0 = np.concatenate([z0, zd0])
+    best = np.inf
+    for _ in range(5):
+        t0 = time.process_time()
+        for _ in range(3):
+            m.rhs(0.0, y0)
+        best = min(best, (time.process_time() - t0) / 3)
+    row = {"sweep": sweep, "n_booms": n_booms, "n_sub": n_sub, "n_dof": m.n_dof,
+           "rhs_ms": 1e3 * best, "t_sim": T}
+    t0 = time.process_time()
+    try:
+        _, _, st = integrate_rk45(m, y0, T, {"rtol": 1e-5, "atol": 1e-6, "n_output": 2})
+        wall = time.process_time() - t0
+        row.update(n_steps=st["n_steps"], n_rhs=st["n_rhs"], wall_s=wall, wall_per_sim_s=wall / T,
+                   status="ok")
+    except Exception as exc:                               # recorded, not hidden
+        row.update(status=f"failed: {str(exc)[:60]}")
+    print(row, flush=True)
+    return row
+
+
+def fit(x, y) -> float:
+    """Slope of the least-squares line log y = p log x + c."""
+    return float(np.polyfit(np.log(x), np.log(y), 1)[0])
+
+
+def main():
+    os.makedirs(RESULTS, exist_ok=True)
+    stamp = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    header = (f"{stamp}; process CPU time; machine shared with other jobs (2 cores); "
+              f"OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS')}")
+    rows = [measure(3, n, "sub_elements") for n in (2, 4, 8)]
+    rows += [measure(N, 2, "booms") for N in (2, 3, 4, 5)]
+    fits = {}
+    for sweep, key in (("sub_elements", "n_sub"), ("booms", "n_booms")):
+        rs = [r for r in rows if r["sweep"] == sweep and r.get("status") == "ok"]
+        x = [r[key] for r in rs]
+        fits[sweep] = {"wall_per_sim_s": fit(x, [r["wall_per_sim_s"] for r in rs]),
+                       "rhs_ms": fit(x, [r["rhs_ms"] for r in rs]),
+                       "n_dof": fit(x, [r["n_dof"] for r in rs])}
+    with open(os.path.join(RESULTS, "cost_growth.csv"), "w", newline="") as fh:
+        fh.write("# " + header + "\n")
+        for sweep, f in fits.items():
+            fh.write(f"# fitted exponent ({sweep}): " +
+                     ", ".join(f"{k} ~ x^{v:.2f}" for k, v in f.items()) + "\n")
+        w = csv.DictWriter(fh, FIELDS)
+        w.writeheader()
+        for r in rows:
+            w.writerow({k: r.get(k, "") for k in FIELDS})
+    print(fits)
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
+    for ax, (sweep, key, label) in zip(axes, (("sub_elements", "n_sub", "sub-elements per spline element (3 booms)"),
+                                              ("booms", "n_booms", "number of booms (2 sub-elements)"))):
+        rs = [r for r in rows if r["sweep"] == sweep and r.get("status") == "ok"]
+        x = np.array([r[key] for r in rs], float)
+        for yk, mk, unit in (("wall_per_sim_s", "o-", "wall s / simulated s"), ("rhs_ms", "s--", "ms per RHS")):
+            y = np.array([r[yk] for r in rs])
+            ax.loglog(x, y, mk, label=f"{unit} (slope {fits[sweep][yk]:.2f})")
+        ax.set_xlabel(label)
+        ax.set_xticks(x)
+        ax.set_xticklabels([f"{v:g}" for v in x])
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle("Telescopic model cost growth (RK45, filter h = 0.01 s); " + header, fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(RESULTS, "cost_growth.png"), dpi=110)
+
+
+if __name__ == "__main__":
+    main()
