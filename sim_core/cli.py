@@ -91,9 +91,13 @@ def cmd_run(args) -> int:
     summary = {"scene": scene["name"], **result.stats}
     atomic_write_bytes(out / "summary.json", json.dumps(summary, indent=2, default=str).encode())
     figs = [] if args.no_plots else _plots(result, out)
-    print(f"{scene['name']}: {scene['solver']['t_end']:g} s simulated in "
-          f"{result.stats['wall_time_s']:.1f} s wall (RTF {result.stats['real_time_factor']:.3g}); "
-          f"{result.stats['n_steps']} steps, {result.stats['n_rhs']} RHS; wrote {out}/result.npz, "
+    st = result.stats
+    wall = float(st.get("wall_time_s", 0.0))
+    rtf = st.get("real_time_factor", scene["solver"]["t_end"] / max(wall, 1e-12))
+    work = "; ".join(f"{st[k]} {label}" for k, label in
+                     (("n_steps", "steps"), ("n_rhs", "RHS")) if k in st)
+    print(f"{scene['name']}: {scene['solver']['t_end']:g} s simulated in {wall:.1f} s wall "
+          f"(RTF {rtf:.3g})" + (f"; {work}" if work else "") + f"; wrote {out}/result.npz, "
           f"summary.json" + (f", {len(figs)} figures" if figs else ""))
     return 0
 

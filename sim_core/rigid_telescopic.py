@@ -132,7 +132,7 @@ class RigidTelescopic:
         sch = self.schedule
         a2, v2, acc2 = (np.array([f(tk) for tk in t]) for f in (sch.stroke, sch.rate, sch.accel))
         wall = time.perf_counter()
-        stats = {"method": "RK45" if self.elastic else "kinematic", "n_steps": 0, "nfev": 0}
+        stats = {"method": "RK45" if self.elastic else "kinematic", "n_steps": 0, "n_rhs": 0}
         if self.elastic:
             sol = solve_ivp(self._rhs, (0.0, t_end), [self.a30, 0.0], method="RK45", t_eval=t,
                             rtol=rtol, atol=atol)
@@ -141,12 +141,13 @@ class RigidTelescopic:
                 raise SimulationError(float(sol.t[-1]), f"rigid telescopic rope dof: {sol.message}")
             a3, v3 = sol.y
             acc3 = np.array([self._rhs(tk, y)[1] for tk, y in zip(t, sol.y.T)])
-            stats.update(nfev=int(sol.nfev), n_steps=int(len(sol.t)))
+            stats.update(n_rhs=int(sol.nfev), n_steps=int(len(sol.t)))
         elif self.ropes:
             a3, v3, acc3 = 2 * a2, 2 * v2, 2 * acc2
         else:
             a3 = v3 = acc3 = None
         stats["wall_time_s"] = time.perf_counter() - wall
+        stats["real_time_factor"] = t_end / max(stats["wall_time_s"], 1e-12)
         n = len(t)
         pos = [np.zeros(n), a2] + ([a3] if a3 is not None else [])
         vel = [np.zeros(n), v2] + ([v3] if v3 is not None else [])

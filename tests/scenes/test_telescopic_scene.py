@@ -5,6 +5,7 @@ import math
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 from sim_core import SceneError, load_scene
@@ -121,3 +122,22 @@ def test_cli_exits_2_with_one_line_on_a_bad_telescopic_scene():
                            "--set", "booms.E=-1"], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 2
     assert "booms.E = -1" in proc.stderr and "Traceback" not in proc.stderr
+
+
+@pytest.mark.parametrize("args", [
+    ["telescopic_extraction_rl"],
+    ["telescopic_extraction_rigid", "--set", "effects.flexible=false"],
+])
+def test_cli_runs_the_fast_fidelities(tmp_path, args):
+    """The ROM and the rigid limit run through the same CLI and write the result contract."""
+    from sim_core.result import Result
+    out = tmp_path / "out"
+    proc = subprocess.run([sys.executable, "-m", "sim_core.cli", "run", *args, "--out", str(out),
+                           "--quiet", "--set", "solver.t_end=6"],
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    res = Result.load(out / "result.npz")
+    assert res.t[-1] == pytest.approx(6.0)
+    for key in ("tip_position", "piston_stroke"):
+        assert np.all(np.isfinite(res[key]))
+    assert (out / "summary.json").exists()
