@@ -71,7 +71,7 @@ def constrained_static_equilibrium(model: Model, z0: np.ndarray, t: float = 0.0,
                                    tol: float = 1e-7, max_iter: int = 30):
     """Static equilibrium with nonlinear constraints: P^T F(z) + C(z)^T lambda = 0, Phi(z) = 0.
 
-    Newton on (z, lambda) with a forward-difference tangent of the force part (the constraint
+    Newton on (z, lambda) with a central-difference tangent of the force part (the constraint
     Jacobian C is analytic).  Returns (z, lambda); lambda are the static constraint reactions
     (e.g. the luffing-cylinder force).  Converged when the force residual is below tol times
     the largest applied generalized force and |Phi| < 1e-10 m, or when the update stalls at
@@ -94,13 +94,19 @@ def constrained_static_equilibrium(model: Model, z0: np.ndarray, t: float = 0.0,
         r1 = Fr + C.T @ lam
         if np.linalg.norm(r1) <= tol * scale and np.max(np.abs(phi), initial=0.0) < 1e-10:
             return z, lam
-        h = 1e-7 * max(1.0, float(np.max(np.abs(z))))
+        # central differences: the Newton system of stiff booms is dominated by cancellation
+        # (entries EA/l ~ 1e13 N/m against residuals ~ 1e5 N), and the O(h) truncation error of
+        # forward differences (~1e-6 relative) made the Newton step useless at 8 sub-elements
+        # (benchmarks/diagnose_static_tangent.py); the O(h^2) error of central ones does not
+        h = 1e-6 * max(1.0, float(np.max(np.abs(z))))
         K = np.empty((n, n))
         for j in range(n):
             zj = z.copy()
             zj[j] += h
-            Fj, _, Cj = parts(zj)
-            K[:, j] = ((Fj + Cj.T @ lam) - r1) / h
+            Fp, _, Cp = parts(zj)
+            zj[j] -= 2 * h
+            Fm, _, Cm = parts(zj)
+            K[:, j] = ((Fp + Cp.T @ lam) - (Fm + Cm.T @ lam)) / (2 * h)
         m = C.shape[0]
         A = np.block([[K, C.T], [C, np.zeros((m, m))]])
         try:
