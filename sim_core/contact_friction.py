@@ -50,7 +50,8 @@ class ContactFriction:
 
     def __init__(self, ts, mu_static: float, mu_dynamic: float, v_eps: float,
                  k0: float = 1e9, eps: float = 1e-6, distribution: bool = True,
-                 slider_half_width: float = 0.15, springs_per_quarter: int = 20):
+                 slider_half_width: float = 0.15, springs_per_quarter: int = 20,
+                 radial_gap: float | None = None):
         self.ts = ts
         self.distribution = distribution
         self.law = FrictionLaw(mu_static, mu_dynamic, v_eps)
@@ -63,7 +64,7 @@ class ContactFriction:
             inner = material_point(m, k, s_index=ts.s2_index[k])
             outer = material_point(m, k + 1, s_index=ts.s3_index[k + 1])
             geo = tuple(SliderGeometry.paper_region(k + 1, kind, springs_per_quarter,
-                                                    slider_half_width)
+                                                    slider_half_width, radial_gap)
                         for kind in ("inner", "outer")) if distribution else (None, None)
             self.regions.append((f"I_{k + 1}{k + 2}", inner, ts.s2_index[k], geo[0]))
             self.regions.append((f"II_{k + 1}{k + 2}", outer, ts.s3_index[k + 1], geo[1]))

@@ -78,6 +78,7 @@ class TelescopicParams:
     spring_eps: float = 1e-6                # m, smoothing interval
     slider_width: float = 0.3               # m, 2w: slider length along the boom (SCENARIOS A1)
     springs_per_quarter: int = 20           # radial springs per quarter arc and slider end (A6)
+    radial_gap: float = 0.005               # m, gap between adjacent booms' walls (A1, Table 1)
     sections: tuple = field(default=TABLE2)
 
 
@@ -239,7 +240,8 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
         ts.contact = ContactFriction(ts, p.mu_static, p.mu_dynamic, p.v_eps, p.spring_k0,
                                      p.spring_eps, distribution=p.contact_distribution,
                                      slider_half_width=0.5 * p.slider_width,
-                                     springs_per_quarter=p.springs_per_quarter)
+                                     springs_per_quarter=p.springs_per_quarter,
+                                     radial_gap=p.radial_gap)
     if p.friction:
         model.multiplier_forces = [ts.contact]
     return ts

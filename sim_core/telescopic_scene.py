@@ -25,7 +25,9 @@
   [contact]    mu_static (>= 0), mu_dynamic (>= 0), v_eps m/s (> 0, switching speed),
                k0 N/m (> 0, radial spring stiffness), eps m (> 0, stiffness smoothing interval),
                slider_width m (2w, > 0 and shorter than the smallest overlap L - max L_s),
-               springs_per_quarter (1..200 springs per quarter arc and slider end)
+               springs_per_quarter (1..200 springs per quarter arc and slider end),
+               radial_gap m ((0, 0.05]: sliding-block thickness between the walls; sets the
+               contact-circle radius, default 5 mm of Table 1)
   [filtering]  h s (> 0)
   [gravity]    g m/s^2 (> 0, along -Z)
   [model]      reduction ("none" = full model, "modal" = stroke-parametric modal ROM of
@@ -116,7 +118,7 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
                              "reactions are statically indeterminate (allowed: friction = false)")
     c = raw.get("contact", {})
     check_keys(c, {"mu_static", "mu_dynamic", "v_eps", "k0", "eps", "slider_width",
-                   "springs_per_quarter"}, "contact")
+                   "springs_per_quarter", "radial_gap"}, "contact")
     sc["contact"] = {"mu_static": number(c, "mu_static", "contact", 0.15, lo=0.0),
                      "mu_dynamic": number(c, "mu_dynamic", "contact", 0.1, lo=0.0),
                      "v_eps": number(c, "v_eps", "contact", 0.01, lo=0.0, lo_open=True),
@@ -125,7 +127,11 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
                      "slider_width": number(c, "slider_width", "contact", 0.3, lo=0.0,
                                             lo_open=True),
                      "springs_per_quarter": number(c, "springs_per_quarter", "contact", 20,
-                                                   lo=1, hi=200, integer=True)}
+                                                   lo=1, hi=200, integer=True),
+                     # a gap wider than 50 mm would put the contact circle of the 75 mm top arcs
+                     # near their centre (Table 1 radii)
+                     "radial_gap": number(c, "radial_gap", "contact", 0.005, lo=0.0, hi=0.05,
+                                          lo_open=True)}
     # the two sliders of a pair (boom k+1's left-end slider inside boom k, boom k's right-end
     # slider on boom k+1) must fit in the overlap L - L_s(t) at its shortest
     ls_max = max(sc["booms"]["stroke0"], end)
@@ -167,5 +173,6 @@ def params_from_scene(sc: dict):
         contact_distribution=sc["effects"]["contact_distribution"],
         slider_width=sc["contact"]["slider_width"],
         springs_per_quarter=sc["contact"]["springs_per_quarter"],
+        radial_gap=sc["contact"]["radial_gap"],
         torsion=sc["effects"]["torsion"], rope_elasticity=sc["effects"]["rope_elasticity"],
         flexible=sc["effects"]["flexible"])

@@ -312,7 +312,8 @@ class SliderGeometry:
 
     @classmethod
     def paper_region(cls, pair, kind: str, springs_per_quarter: int = 20,
-                     half_width: float | None = None) -> "SliderGeometry":
+                     half_width: float | None = None,
+                     radial_gap: float | None = None) -> "SliderGeometry":
         """A contact region of the paper's three-boom example (Section 9, SCENARIOS A1/A6).
 
         pair : outer boom index k of the pair (k, k+1): 1, 2, or (1, 2), (2, 3), "1-2", "2-3".
@@ -321,7 +322,9 @@ class SliderGeometry:
         Arcs P1 centre (0.3, 0.3), 0-90 deg; P2 (-0.3, 0.3), 90-180 deg; P3 (0, 0), 180-360 deg;
         contact radius = mid-gap between boom k's inner face (outer radius - 15 mm) and boom
         k+1's outer face: 72.5/372.5 mm (pair 1-2), 52.5/352.5 mm (pair 2-3); w = 0.15 m unless
-        ``half_width`` (m) is given.
+        ``half_width`` (m) is given.  ``radial_gap`` (m; Table 1: 5 mm) places the contact circle
+        at the middle of a gap of that width below boom k's inner face (the sliding block fills
+        the gap); the boom sections themselves (Table 2) are not changed by it.
         """
         if isinstance(pair, str):
             pair = tuple(int(p) for p in pair.replace("–", "-").split("-"))
@@ -337,6 +340,9 @@ class SliderGeometry:
         (r_o, big_o), (r_i, big_i) = _TABLE1_OUTER_RADII[k], _TABLE1_OUTER_RADII[k + 1]
         r_top = 0.5 * ((r_o - _WALL) + r_i)         # mid-gap, SCENARIOS A6
         r_half = 0.5 * ((big_o - _WALL) + big_i)
+        if radial_gap is not None:                   # a block of thickness radial_gap
+            r_top = (r_o - _WALL) - 0.5 * radial_gap
+            r_half = (big_o - _WALL) - 0.5 * radial_gap
         nq = int(springs_per_quarter)
         arcs = np.array([
             [_TOP_CENTRE, _TOP_CENTRE, r_top, 0.0, 0.5 * math.pi, nq],          # P1 top right

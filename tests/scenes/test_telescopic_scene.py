@@ -41,6 +41,8 @@ def test_shipped_telescopic_scenes_are_valid(name):
     ("contact.mu_static", -0.1, "[0, inf)"),
     ("contact.slider_width", 0.0, "(0, inf)"),
     ("contact.springs_per_quarter", 0, "[1, 200]"),
+    ("contact.radial_gap", 0.0, "(0, 0.05]"),
+    ("contact.radial_gap", -0.001, "(0, 0.05]"),
     ("filtering.h", 0.0, "(0, inf)"),
     ("solver.t_end", 0.0, "(0, inf)"),
     ("solver.rtol", 1.0, "(0, 1)"),
