@@ -73,3 +73,25 @@ def test_friction_raises_the_telescopic_cylinder_force(systems):
         _, lam = ts.model.accelerations_and_multipliers(0.0, z, zd)
         forces.append(lam[ts.rows["telescopic_cylinder"]][0])
     assert forces[0] > forces[1] * 1.2
+
+
+def test_friction_flips_sign_between_extraction_and_retraction(systems):
+    """Section 8.3: the friction force on a contact coordinate opposes its relative slide, so
+    it changes sign when the motion is reversed; the telescopic cylinder then needs more force
+    when extracting and less when retracting than without friction (the same state)."""
+    ts_f, ts_0, z = systems
+    fr = ts_f.model.multiplier_forces[0]
+    cyl = {}
+    for v in (0.2, -0.2):
+        Q, Qd = _sliding_state(ts_f, z, v)
+        zd = ts_f.model.reduced_state(0.0, Q, Qd)[1]
+        _, lam = ts_f.model.accelerations_and_multipliers(0.0, z, zd)
+        dF = fr.forces(0.0, Q, Qd, lam)
+        for idx in ts_f.s2_index + ts_f.s3_index[1:]:
+            assert dF[idx] * Qd[idx] < 0.0            # opposes the slide
+        cyl[v] = lam[ts_f.rows["telescopic_cylinder"]][0]
+        Q0, Qd0 = _sliding_state(ts_0, z, v)
+        zd0 = ts_0.model.reduced_state(0.0, Q0, Qd0)[1]
+        cyl[(v, 0)] = ts_0.model.accelerations_and_multipliers(0.0, z, zd0)[1][
+            ts_0.rows["telescopic_cylinder"]][0]
+    assert cyl[0.2] > cyl[(0.2, 0)] and cyl[-0.2] < cyl[(-0.2, 0)]
