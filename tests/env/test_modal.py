@@ -135,3 +135,11 @@ def test_rom_matches_full_model_on_a_dynamic_window():
     # represent: stiffness ratio (2.2 / 3.65)^2 = 0.36 ~ the axial deflection ratio.
     assert 0.5 <= res["bending"] <= 2.0 and 0.5 <= res["bending_acc"] <= 2.0
     assert 0.25 <= res["axial"] <= 4.0 and 0.25 <= res["axial_acc"] <= 4.0
+
+
+def test_rom_tip_stays_in_the_luffing_plane():
+    """Symmetric scene, in-plane modes: the ROM tip has no lateral position or velocity."""
+    from sim_core import load_scene, simulate
+    res = simulate(load_scene("telescopic_extraction_rl"))
+    assert np.max(np.abs(res["tip_velocity"][:, 1])) < 1e-12
+    assert np.max(np.abs(res["tip_position"][:, 1])) < 1e-12
