@@ -479,16 +479,11 @@ def scaled_static_equilibrium(m: Model, z0: np.ndarray, t: float = 0.0, k_ref: f
     :func:`sim_core.statics.constrained_static_equilibrium` numerically singular (cond ~ 1e19).
     Forward-difference tangent.  Converged when |r| < tol * (total weight scale) and
     |Phi| < 1e-10.  Returns (z, lambda)."""
-    from .constraints import constraint_terms
     from .errors import SimulationError
+    from .statics import static_parts
     z = np.array(z0, float)
     n = len(z)
-
-    def parts(zz):
-        Q, _ = m.full_state(t, zz, np.zeros_like(zz))
-        _, F = m.mass_force(t, Q, np.zeros_like(Q), mass=False)
-        phi, J, _, _ = constraint_terms(m.nonlinear, t, Q, np.zeros_like(Q))
-        return m.P.T @ F, phi, J @ m.P
+    parts = static_parts(m, t)
 
     Fr, phi, C = parts(z)
     mm = C.shape[0]

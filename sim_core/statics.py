@@ -67,6 +67,19 @@ def linear_modes(model: Model, z_eq: np.ndarray, t: float = 0.0):
     return np.sqrt(np.clip(w2, 0.0, None)), vec
 
 
+def static_parts(model: Model, t: float = 0.0):
+    """z -> (P^T F(z) at rest, Phi(z), C(z) = g_Q P): the pieces of the static residual with
+    nonlinear constraints (forces in N, violations in m or rad)."""
+    from .constraints import constraint_terms
+
+    def parts(zz):
+        Q, _ = model.full_state(t, zz, np.zeros_like(zz))
+        _, F = model.mass_force(t, Q, np.zeros_like(Q), mass=False)
+        phi, J, _, _ = constraint_terms(model.nonlinear, t, Q, np.zeros_like(Q))
+        return model.P.T @ F, phi, J @ model.P
+    return parts
+
+
 def constrained_static_equilibrium(model: Model, z0: np.ndarray, t: float = 0.0,
                                    tol: float = 1e-7, max_iter: int = 30):
     """Static equilibrium with nonlinear constraints: P^T F(z) + C(z)^T lambda = 0, Phi(z) = 0.
@@ -77,16 +90,9 @@ def constrained_static_equilibrium(model: Model, z0: np.ndarray, t: float = 0.0,
     the largest applied generalized force and |Phi| < 1e-10 m, or when the update stalls at
     round-off.
     """
-    from .constraints import constraint_terms
     z = np.array(z0, float)
     n = len(z)
-
-    def parts(zz):
-        Q, Qd = model.full_state(t, zz, np.zeros_like(zz))
-        _, F = model.mass_force(t, Q, np.zeros_like(Q), mass=False)
-        phi, J, _, _ = constraint_terms(model.nonlinear, t, Q, np.zeros_like(Q))
-        return model.P.T @ F, phi, J @ model.P
-
+    parts = static_parts(model, t)
     Fr, phi, C = parts(z)
     lam = np.linalg.lstsq(C.T, -Fr, rcond=None)[0]
     scale = max(np.linalg.norm(Fr), 1.0)
