@@ -67,6 +67,34 @@ def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return out
 
 
+def _offset_jacobian(ctx: ElementContext) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Mass-centre offset d = y_c e_t + z_c e_b (SCENARIOS A1: rigid offset of the mass centre
+    from the reference line, paper Table 2).  Returns (J_c, frame, d_body):
+
+    J_c = J_r + frame^T C J_w, the velocity Jacobian of the mass centre r + d, where C maps the
+    section-frame angular velocity (omega_s, omega_t, omega_b) to omega x d in (e_t, e_b, e_s)
+    components: omega x d = (-z_c omega_s) e_t + (y_c omega_s) e_b + (z_c omega_t - y_c omega_b) e_s.
+    frame (G, 3, 3) rows e_t, e_b, e_s (global); d_body = (y_c, z_c, 0) in (t, b, s) order."""
+    sec = ctx.el.section
+    kin = ctx.kin
+    yc, zc = sec.y_c, sec.z_c
+    C = np.array([[-zc, 0.0, 0.0], [yc, 0.0, 0.0], [0.0, zc, -yc]])
+    frame = kin.sec.frame
+    J_c = kin.J_r + np.einsum("gji,jk,gkn->gin", frame, C, kin.J_w)
+    return J_c, frame, np.array([yc, zc, 0.0])
+
+
+def _offset_convective(frame, d, omega, w_dot):
+    """Convective acceleration of the offset (global): d/dt (omega x d) at q_ddot = 0 =
+    w_dot x d + omega x (omega x d), evaluated in body components (t, b, s) (the body-frame rate
+    of body components of omega equals the inertial one) and rotated to global."""
+    w3 = omega[:, [1, 2, 0]]                 # (s, t, b) -> (t, b, s)
+    wd3 = w_dot[:, [1, 2, 0]]
+    dd = np.broadcast_to(d, w3.shape)
+    a_b = _cross(wd3, dd) + _cross(w3, _cross(w3, dd))
+    return np.einsum("gji,gj->gi", frame, a_b)
+
+
 class Effect:
     """Base class: ``needs`` lists kinematic quantities this effect reads."""
 
@@ -92,6 +120,9 @@ class Inertia(Effect):
         kin, wl = ctx.kin, ctx.wl
         Jd = sec.J
         J_r, J_w = kin.J_r, kin.J_w
+        if sec.has_offset:
+            self._with_offset(ctx, M, F)
+            return
         if M is not None:
             M += _gram_stacked([(J_r, np.sqrt(wl * sec.rhoA)[:, None].repeat(3, axis=1)),
                                 (J_w, np.sqrt(wl[:, None] * Jd))])
@@ -99,6 +130,25 @@ class Inertia(Effect):
             omega = J_w @ ctx.qde
             rot = Jd * ctx.conv["w_dot"] + _cross(omega, Jd * omega)
             F -= _jt_v(J_r, (wl * sec.rhoA)[:, None] * ctx.conv["a"])
+            F -= _jt_v(J_w, wl[:, None] * rot)
+
+    @staticmethod
+    def _with_offset(ctx, M, F):
+        """Mass centre offset from the reference line (SCENARIOS A1 / paper Table 2): the
+        translational terms use the mass-centre Jacobian J_c and acceleration."""
+        sec = ctx.el.section
+        kin, wl = ctx.kin, ctx.wl
+        Jd = sec.J
+        J_w = kin.J_w
+        J_c, frame, d = _offset_jacobian(ctx)
+        if M is not None:
+            M += _gram_stacked([(J_c, np.sqrt(wl * sec.rhoA)[:, None].repeat(3, axis=1)),
+                                (J_w, np.sqrt(wl[:, None] * Jd))])
+        if ctx.conv is not None:
+            omega = J_w @ ctx.qde
+            rot = Jd * ctx.conv["w_dot"] + _cross(omega, Jd * omega)
+            a_c = ctx.conv["a"] + _offset_convective(frame, d, omega, ctx.conv["w_dot"])
+            F -= _jt_v(J_c, (wl * sec.rhoA)[:, None] * a_c)
             F -= _jt_v(J_w, wl[:, None] * rot)
 
 
@@ -160,7 +210,9 @@ class Gravity(Effect):
         self.g = np.asarray(g, dtype=float)
 
     def element_terms(self, ctx, M, F):
-        F += _jt_v(ctx.kin.J_r, (ctx.wl * ctx.el.section.rhoA)[:, None] * self.g)
+        # weight at the mass centre: with an offset (SCENARIOS A1) the mass-centre Jacobian
+        J = _offset_jacobian(ctx)[0] if ctx.el.section.has_offset else ctx.kin.J_r
+        F += _jt_v(J, (ctx.wl * ctx.el.section.rhoA)[:, None] * self.g)
 
 
 @dataclass

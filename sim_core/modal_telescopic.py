@@ -53,6 +53,7 @@ above the kept ones (static correction not added), off-diagonal modal damping, a
 from __future__ import annotations
 
 import argparse
+import os
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -212,13 +213,30 @@ def build_config(payload, angle_deg, L_grid=L_GRID, stroke_ref=STROKE_REF, n_nod
     return out
 
 
-def build_tables(path=DATA, payloads=PAYLOADS, angles=ANGLES, L_grid=L_GRID, log=print):
-    """Build all configurations and write them to ``path`` (npz)."""
+def build_tables(path=DATA, payloads=PAYLOADS, angles=ANGLES, L_grid=L_GRID, log=print,
+                 reuse=None):
+    """Build all configurations and write them to ``path`` (npz).  ``reuse``: an existing
+    tables file; configurations it holds on the same L_s grid are copied, not rebuilt."""
     t0 = time.perf_counter()
     data = {}
+    old = None
+    if reuse is not None and Path(reuse).exists():
+        with np.load(reuse) as f:
+            old = {k: f[k] for k in f.files}
+        if old["L_grid"].shape != np.shape(L_grid) or not np.allclose(old["L_grid"], L_grid):
+            old = None
     for a in angles:
         for mp_ in payloads:
-            cfg = build_config(mp_, a, L_grid, log=log)
+            cfg = None
+            if old is not None:
+                ia = np.flatnonzero(np.isclose(old["angles"], a))
+                ip = np.flatnonzero(np.isclose(old["payloads"], mp_))
+                if len(ia) and len(ip):
+                    cfg = {k: old[k][ia[0], ip[0]] for k in COLS + ("tip_static", "tip_dL",
+                                                                     "freq_all_hz")}
+                    log(f"  m_p={mp_:g} kg theta={a:g} deg: reused from {reuse}")
+            if cfg is None:
+                cfg = build_config(mp_, a, L_grid, log=log)
             for k, v in cfg.items():
                 data.setdefault(k, []).append(v)
     arrays = {k: np.array(v).reshape(len(angles), len(payloads), *np.shape(v[0]))
@@ -227,7 +245,9 @@ def build_tables(path=DATA, payloads=PAYLOADS, angles=ANGLES, L_grid=L_GRID, log
                 n_nodes=N_NODES, stroke_ref=STROKE_REF, build_s=time.perf_counter() - t0)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    np.savez_compressed(path, **arrays, **meta)
+    tmp = path.with_name(path.stem + ".tmp.npz")
+    np.savez_compressed(tmp, **arrays, **meta)
+    os.replace(tmp, path)
     log(f"wrote {path} ({time.perf_counter() - t0:.0f} s)")
 
 
@@ -474,12 +494,19 @@ def main(argv=None):
     ap.add_argument("--build", action="store_true", help="(re)build the tables")
     ap.add_argument("--quick", action="store_true", help="one configuration (25 t, 60 deg) only")
     ap.add_argument("--out", default=str(DATA))
+    ap.add_argument("--angles", type=float, nargs="+", default=list(ANGLES),
+                    help="luffing angles, deg (default: %(default)s)")
+    ap.add_argument("--payloads", type=float, nargs="+", default=list(PAYLOADS),
+                    help="payload masses, kg (default: %(default)s)")
+    ap.add_argument("--reuse", default=None,
+                    help="existing tables file whose configurations are copied, not rebuilt")
     a = ap.parse_args(argv)
     if a.build:
         if a.quick:
             build_tables(a.out, payloads=(25000.0,), angles=(60.0,))
         else:
-            build_tables(a.out)
+            build_tables(a.out, payloads=tuple(sorted(a.payloads)), angles=tuple(sorted(a.angles)),
+                         reuse=a.reuse)
     else:
         ap.print_help()
 

@@ -246,9 +246,17 @@ class Model:
                 v = np.einsum("gin,n->gi", kin.J_r, qde)
                 w = np.einsum("gin,n->gi", kin.J_w, qde)
                 sec = el.section
+                r = kin.r
+                if sec.has_offset:          # mass centre r + d (SCENARIOS A1), see effects
+                    d_glob = kin.sec.frame[:, 0] * sec.y_c + kin.sec.frame[:, 1] * sec.z_c
+                    ws = w[:, [1, 2, 0]]    # (s, t, b) -> (t, b, s) body components
+                    wxd = np.stack([-sec.z_c * ws[:, 2], sec.y_c * ws[:, 2],
+                                    sec.z_c * ws[:, 0] - sec.y_c * ws[:, 1]], axis=1)
+                    v = v + np.einsum("gji,gj->gi", kin.sec.frame, wxd)
+                    r = r + d_glob
                 T += 0.5 * np.dot(wl, sec.rhoA * np.sum(v * v, axis=1) + w * w @ sec.J)
                 U += np.dot(wl, el.strain_energy_density(kin))
-                V -= np.dot(wl * sec.rhoA, kin.r @ g)
+                V -= np.dot(wl * sec.rhoA, r @ g)
         return {"T": float(T), "U": float(U), "V": float(V)}
 
     # -- points ------------------------------------------------------------------------------

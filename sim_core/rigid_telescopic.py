@@ -19,8 +19,8 @@ Positions along e_s of the left sections (a_1 = 0, a_2 = L_s(t), a_3):
   with l_e = l_e0 + 2 (a_2 - a_2,0) - (a_3 - a_3,0) and l_r = l_r0 - 2 (a_2 - a_2,0) + (a_3 - a_3,0)
   (all rope points lie on the axis in the straight rigid state).
 
-Forces (d'Alembert, frictionless sliding, boom mass centres on the axis: z_c = 0 as in the
-flexible model):
+Forces (d'Alembert, frictionless sliding; boom mass centres on the axis, or offset by z_c along
+e_b with ``mass_centre_offset``, as in the flexible model):
 
 * telescopic cylinder (pushing positive): F_tel = m_2 (a_2'' + g sin theta) + 2 T_e - 2 T_r
   (axial balance of boom 2; static form SCENARIOS C7: m_2 g sin th + 2 T);
@@ -68,6 +68,9 @@ class RigidTelescopic:
         self.origin = np.asarray(self.geo.origin, float)
         self.L = p.boom_length
         self.masses = [boom_section(k, p).rhoA * self.L for k in range(p.n_booms)]
+        # mass centres offset along e_b (Table 2, SCENARIOS A1) when switched on
+        self.z_c = [boom_section(k, p).z_c for k in range(p.n_booms)]
+        self.e_b = np.asarray(self.geo.rotation, float) @ np.array([0.0, 0.0, 1.0])
         self.schedule = CubicSmoothstepSchedule(v_max=p.v_max, t_ramp=p.t_ramp,
                                                 t_hold_end=p.t_hold_end, sign=p.direction,
                                                 s0=p.stroke0)
@@ -111,11 +114,11 @@ class RigidTelescopic:
         gvec = np.array([0.0, 0.0, -self.g])
         d1 = np.asarray(self.geo.d1, float)
         M = 0.0
-        bodies = [(m, a + 0.5 * self.L, acc) for m, a, acc in
-                  zip(self.masses, positions, accelerations)]
-        bodies.append((self.p.payload, positions[-1] + self.L, accelerations[-1]))
-        for m, x, acc in bodies:
-            r = self.origin + x * self.e
+        bodies = [(m, a + 0.5 * self.L, acc, zc) for m, a, acc, zc in
+                  zip(self.masses, positions, accelerations, self.z_c)]
+        bodies.append((self.p.payload, positions[-1] + self.L, accelerations[-1], 0.0))
+        for m, x, acc, zc in bodies:
+            r = self.origin + x * self.e + zc * self.e_b
             M += float(np.cross(r - d1, m * (gvec - acc * self.e))[1])
         d3, d2 = np.asarray(self.geo.d3, float), np.asarray(self.geo.d2, float)
         u = (d3 - d2) / np.linalg.norm(d3 - d2)

@@ -71,6 +71,8 @@ class TelescopicParams:
     torsion: bool = True                    # torsion angles as coordinates; off = held at zero
     rope_elasticity: bool = True            # elastic tension-only ropes; off = one inextensible rope
     flexible: bool = True                   # flexible booms; off = rigid kinematic limit
+    mass_centre_offset: bool = False        # Table 2 z_c as rigid offset (SCENARIOS A1)
+    z_c: tuple = (0.045, 0.044, 0.043)      # m, mass centre along e_b (Table 2)
     mu_static: float = 0.15
     mu_dynamic: float = 0.1
     v_eps: float = 0.01                     # m/s, switching speed
@@ -86,8 +88,10 @@ def boom_section(k: int, p: TelescopicParams) -> BeamSection:
     EI, GJ, m = p.sections[min(k, len(p.sections) - 1)]
     scale = p.E / 2.1e11                   # case 9.1: stiffnesses x10, masses unchanged
     I = EI / 2.1e11                         # second moment from Table 2
+    # mass-centre offset along e_b (Table 2), a rigid offset in inertia and gravity (A1)
+    zc = p.z_c[min(k, len(p.z_c) - 1)] if p.mass_centre_offset else 0.0
     return BeamSection(EA=p.E * m / p.rho, GJ=GJ * scale, EI_t=EI * scale, EI_b=EI * scale,
-                       rhoA=m, J_s=2 * p.rho * I, J_t=p.rho * I, J_b=p.rho * I)
+                       rhoA=m, J_s=2 * p.rho * I, J_t=p.rho * I, J_b=p.rho * I, z_c=zc)
 
 
 @dataclass

@@ -21,7 +21,10 @@
                slider_contact_forces, and the friction normal load = spring sum; false = only
                the constraint resultants, friction normal load = transverse resultant),
                rope_elasticity (bool, default true: elastic tension-only ropes with [ropes] EA;
-               false = one inextensible rope constraint, output rope_tension)
+               false = one inextensible rope constraint, output rope_tension),
+               mass_centre_offset (bool, default false: mass on the reference line; true =
+               the Table 2 offsets z_c = 0.045/0.044/0.043 m as a rigid offset in inertia and
+               gravity, SCENARIOS A1; the modal ROM tables are built without it)
   [contact]    mu_static (>= 0), mu_dynamic (>= 0), v_eps m/s (> 0, switching speed),
                k0 N/m (> 0, radial spring stiffness), eps m (> 0, stiffness smoothing interval),
                slider_width m (2w, > 0 and shorter than the smallest overlap L - max L_s),
@@ -95,7 +98,7 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
     sc["ropes"] = {"EA": number(r, "EA", "ropes", 1e8, lo=0.0, lo_open=True)}
     e = raw.get("effects", {})
     check_keys(e, {"gravity", "filtering", "friction", "contact_distribution", "torsion",
-                   "rope_elasticity", "flexible"}, "effects")
+                   "rope_elasticity", "flexible", "mass_centre_offset"}, "effects")
     three = sc["booms"]["count"] == 3
     sc["effects"] = {"flexible": boolean(e, "flexible", "effects", True),
                      "torsion": boolean(e, "torsion", "effects", True),
@@ -103,7 +106,8 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
                      "filtering": boolean(e, "filtering", "effects", True),
                      "friction": boolean(e, "friction", "effects", False),
                      "contact_distribution": boolean(e, "contact_distribution", "effects", three),
-                     "rope_elasticity": boolean(e, "rope_elasticity", "effects", True)}
+                     "rope_elasticity": boolean(e, "rope_elasticity", "effects", True),
+                     "mass_centre_offset": boolean(e, "mass_centre_offset", "effects", False)}
     eff = sc["effects"]
     if eff["contact_distribution"] and not three:
         raise SceneError(f"effects.contact_distribution = true with booms.count = "
@@ -175,4 +179,5 @@ def params_from_scene(sc: dict):
         springs_per_quarter=sc["contact"]["springs_per_quarter"],
         radial_gap=sc["contact"]["radial_gap"],
         torsion=sc["effects"]["torsion"], rope_elasticity=sc["effects"]["rope_elasticity"],
-        flexible=sc["effects"]["flexible"])
+        flexible=sc["effects"]["flexible"],
+        mass_centre_offset=sc["effects"]["mass_centre_offset"])

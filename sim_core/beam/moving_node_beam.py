@@ -54,6 +54,10 @@ class BeamSection:
     about e_t and e_b, N m^2.  rhoA : mass per length, kg/m.  J_s, J_t, J_b : rotary inertia
     per length about e_s, e_t, e_b, kg m (= rho I).
     Constitutive diagonal D = diag(EA, GJ, EI_t, EI_b) (Eq. 36).
+    y_c, z_c : mass-centre offset from the reference line along e_t and e_b, m (paper Table 2:
+    z_c = 0.045 / 0.044 / 0.043 m).  A rigid offset in inertia and gravity (SCENARIOS A1 PD):
+    the stiffness stays on the reference line; the rotary inertia J is taken about the mass
+    centre.  0 (default): mass on the reference line.
     """
 
     EA: float
@@ -64,6 +68,12 @@ class BeamSection:
     J_s: float
     J_t: float = 0.0
     J_b: float = 0.0
+    y_c: float = 0.0
+    z_c: float = 0.0
+
+    @property
+    def has_offset(self) -> bool:
+        return self.y_c != 0.0 or self.z_c != 0.0
 
     @property
     def D(self) -> np.ndarray:

@@ -47,8 +47,8 @@ def test_initial_configuration_satisfies_constraints_and_matches_paper_geometry(
 def test_static_forces_match_rigid_balance(rigid_equilibrium):
     """SCENARIOS C7: luffing-cylinder force from moments about D1, telescopic force
     m2 g sin(th) + 2 T and extraction-rope tension T = (m3 + m_p) g sin(th); 0.5 % (rigid).
-    The mass centre lies on the reference line in this model (z_c offset not yet modelled), so
-    the reference is evaluated with z_c = 0."""
+    The mass centre lies on the reference line by default (mass_centre_offset = false), so the
+    reference is evaluated with z_c = 0 (with the offsets: test_mass_centre_offset.py)."""
     ts, z, lam = rigid_equilibrium
     ref = static_luffing_forces(np.radians(60.0), 2.0, 1000.0, z_c=(0.0, 0.0, 0.0))
     assert abs(lam[ts.rows["luffing_cylinder"]][0]) == pytest.approx(ref.luffing_force, rel=5e-3)
