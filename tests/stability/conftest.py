@@ -79,7 +79,8 @@ def rope_energy(rope, ell: float) -> float:
 
 def mechanical_energy(ts, t: float, y: np.ndarray) -> float:
     """Kinetic + strain + gravity energy of the booms, payload point mass and rope strain (J).
-    Only meaningful with the stress filter off (the filter adds rate-dependent inertia terms)."""
+    The stress filter's rate terms are not included: with the filter on, a run from rest has
+    E(t) - E(0) <= W (the filter's inertia-like term is >= 0 and its damping term dissipates)."""
     m, p = ts.model, ts.params
     n = m.n_dof
     Q, Qd = m.full_state(t, y[:n], y[n:])
@@ -95,13 +96,20 @@ def mechanical_energy(ts, t: float, y: np.ndarray) -> float:
     return float(np.real(E))
 
 
+class StepCollapse(AssertionError):
+    """An accepted RK45 step below the stated floor: the run is stopped there (a stalled
+    integrator would otherwise take hours to reach the end of the window)."""
+
+
 def run_window(ts, y0, t_end: float, n_output: int = 21, rtol: float = 1e-6, atol: float = 1e-7,
-               energy: bool = False):
+               energy: bool = False, step_floor: float | None = None):
     """Integrate ts from y0 over [0, t_end] (RK45 of sim_core) and return the Result (outputs of
     the telescopic contract).  With ``energy``: also outputs ``energy`` (J, mechanical energy
     incl. payload and ropes) and ``cylinder_work`` (J, cumulative trapezoidal work of the
-    telescopic cylinder, force = -lambda (the multiplier is positive in tension) times the
-    prescribed rate).  A SimulationError propagates with its partial result attached."""
+    telescopic cylinder: its multiplier times the prescribed rate; with this model's sign
+    convention the multiplier is the pushing force, positive in an extraction against gravity).  A SimulationError propagates with its partial result attached.  With
+    ``step_floor``: raises StepCollapse at the first accepted step shorter than the floor (the
+    final step, cut to land on t_end, excepted)."""
     m = ts.model
     sol = {"rtol": rtol, "atol": atol, "n_output": n_output}
     cyl = next(c for c in m.nonlinear if c.name == "telescopic_cylinder")
@@ -111,12 +119,37 @@ def run_window(ts, y0, t_end: float, n_output: int = 21, rtol: float = 1e-6, ato
         if energy:
             res.outputs["energy"] = np.array([mechanical_energy(ts, tk, y) for tk, y in zip(t, ys)])
             rate = np.array([cyl.target(tk)[1] for tk in t], dtype=float).reshape(len(t), -1)[:, 0]
-            power = -res["telescopic_cylinder_force"] * rate
+            power = res["telescopic_cylinder_force"] * rate
             res.outputs["cylinder_work"] = np.concatenate(
                 [[0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(t))])
         return res
 
-    return run_with_partial(lambda: integrate_rk45(m, y0, t_end, sol), collect)
+    last = [0.0]
+
+    def watch(t, wall):
+        h = t - last[0]
+        last[0] = t
+        if step_floor is not None and h < step_floor and t < t_end - step_floor:
+            raise StepCollapse(f"accepted RK45 step {h:.3g} s < floor {step_floor:g} s at "
+                               f"t = {t:.6g} s (wall {wall:.1f} s)")
+
+    return run_with_partial(lambda: integrate_rk45(m, y0, t_end, sol, watch), collect)
+
+
+def energy_tol(ts, res) -> float:
+    """Energy tolerance of a run (J): ENERGY_REL_TOL of the exchanged energy plus the total
+    weight times ENERGY_POSITION_ERROR (see thresholds.py)."""
+    from .thresholds import ENERGY_POSITION_ERROR, ENERGY_REL_TOL
+    p = ts.params
+    weight = p.gravity * (sum(b.section.rhoA * b.length for b in ts.model.beams) + p.payload)
+    scale = np.ptp(res["energy"]) + np.max(np.abs(res["cylinder_work"]))
+    return ENERGY_REL_TOL * scale + weight * ENERGY_POSITION_ERROR
+
+
+def assert_no_energy_created(ts, res):
+    """E(t) - E(0) - W_cyl(t) <= tolerance (friction and the stress filter only dissipate)."""
+    excess = res["energy"] - res["energy"][0] - res["cylinder_work"]
+    assert np.max(excess) <= energy_tol(ts, res), (np.max(excess), energy_tol(ts, res))
 
 
 def assert_stable(res, min_step_floor: float, violation_tol: float):

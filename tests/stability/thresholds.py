@@ -31,7 +31,12 @@ MIN_STEP_FRICTION = 1e-5              # s
 CONSTRAINT_TOL = 1e-6
 
 # ---------------------------------------------------------------- energy balance
-# Frictionless model with the stress filter off is conservative: E(t) - E(0) = W_cylinder(t)
+# The runs keep the paper's stress filter (h = 0.01 s): it adds (h^2/6) int B'DB to the mass
+# matrix, which caps the highest frequencies near sqrt(6)/h ~ 245 rad/s and so the explicit
+# RK45 step near 10 ms (without it the axial modes force ~0.3 ms steps: too slow for this
+# suite).  Its extra terms are an inertia-like energy >= 0 and a dissipation (h/2) eps_dot' D
+# eps_dot, so from rest the balance is the inequality E(t) - E(0) - W_cylinder(t) <= tol.
+# Frictionless and filter off the model is conservative: E(t) - E(0) = W_cylinder(t)
 # (the luffing cylinder has fixed length; pivot and contact constraints are scleronomic and
 # frictionless; Baumgarte forces do O(violation * lambda) ~ 1e-6 m * 1e5 N = 0.1 J of work).
 # Error budget: RK45 at rtol 1e-6 keeps the state's relative error ~1e-6 per step, i.e. an
@@ -40,12 +45,13 @@ CONSTRAINT_TOL = 1e-6
 # 1e-3 of the energy scale (range of the mechanical energy over the run, plus |work|), ten
 # times the budget.
 ENERGY_REL_TOL = 1e-3
-# Absolute floor of the energy tolerance (J): when nothing moves (a hold at equilibrium) the
-# energy scale is ~0; 1 J is the Baumgarte work bound above times ten.
-ENERGY_ABS_TOL = 1.0
+# Absolute part: the energy is evaluated from states that RK45 carries with a position error
+# ~ rtol * |q| + atol ~ 1e-6 * 10 m = 1e-5 m, so the gravity potential alone is uncertain by
+# (total weight) * 1e-5 m (~3 J for the paper's 25 t scene).  Tolerance: total weight times
+# 1e-4 m (ten times that position error).
+ENERGY_POSITION_ERROR = 1e-4          # m
 
-# With friction (dissipative) the balance is an inequality: E(t) - E(0) - W(t) <= tolerance
-# (friction only removes energy).  Same tolerances.
+# With friction (dissipative) the inequality holds a fortiori (friction only removes energy).
 
 # ---------------------------------------------------------------- long hold
 # Hold at rest: the modal ROM's energy 1/2 sum(q_dot^2 + omega^2 q^2) (mass-normalised modes)
