@@ -13,12 +13,14 @@ import math
 import numpy as np
 import pytest
 
+from sim_core.errors import SimulationError
 from sim_core.rigid_telescopic import RigidTelescopic
 from sim_core.telescopic import TelescopicParams
 from sim_core.validation.closed_form import luffing_geometry
 
 from .conftest import assert_stable, build_at_equilibrium, run_window
-from .test_geometry_extremes import SOFT_CROSSING, STIFF_EXTENSION, energy_balanced
+from .test_geometry_extremes import (SOFT_CROSSING, STIFF_EQUILIBRIUM_FAILS, STIFF_EXTENSION,
+                                     energy_balanced)
 from .thresholds import CONSTRAINT_TOL, ENERGY_REL_TOL, MIN_STEP_FRICTIONLESS
 
 GRID = list(itertools.product((2.1e12, 2.1e10), (0.0, 25000.0), (0.0, 80.0)))
@@ -66,12 +68,15 @@ def _flexible(kw, t_end=0.2, n_out=21):
     return res
 
 
+@pytest.mark.slow
 def test_flexible_soft_heavy_steep():
     """E = 2.1e10 Pa, 25 t, 80 deg: start, 0.05 m stroke in 0.2 s and stop."""
     _flexible({k: SOFT_CROSSING[k] for k in ("n_nodes", "E", "payload", "luffing_angle_deg",
                                              "stroke0")})
 
 
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, raises=SimulationError, reason=STIFF_EQUILIBRIUM_FAILS)
 def test_flexible_stiff_unloaded_horizontal():
     """E = 2.1e12 Pa, no payload, 0 deg (boom horizontal): the same drive."""
     _flexible({k: STIFF_EXTENSION[k] for k in ("n_nodes", "E", "payload", "luffing_angle_deg",
