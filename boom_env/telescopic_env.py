@@ -68,8 +68,11 @@ Reward (per step; all weights are constructor arguments)
         - w_jerk * ((a - a_prev) / a_max)^2                   (jerk, per step)
         - w_end_stop * [end stop hit this step]
         + bonus                                               (on success, see termination)
-Defaults: w_time = 1, w_progress = 1, w_deflection = 1, w_rate = 1, w_effort = 0.1,
-w_jerk = 0.1, w_end_stop = 10, bonus = 50.
+Defaults: w_time = 1, w_progress = 10, w_deflection = 1, w_rate = 1, w_effort = 0.1,
+w_jerk = 0.1, w_end_stop = 10, bonus = 50.  The progress weight makes standing still (-11 per
+second) clearly worse than extracting: with w_progress = 1 a PPO agent learned to stay at the
+start (return ~ -60 over 30 s) because the paper's cubic schedule, which pays ~3 mm of tip
+deflection while decelerating, scores ~ -76 (agents/README notes).
 
 Start state
 -----------
@@ -123,7 +126,7 @@ class TelescopicBoomEnv(gym.Env):
                  payload_range: tuple[float, float] | None = None,
                  angle_range: tuple[float, float] | None = None,
                  n_modes: int = 3, paper_n_nodes: int = 3, paper_friction: bool = False,
-                 w_time: float = 1.0, w_progress: float = 1.0, w_deflection: float = 1.0,
+                 w_time: float = 1.0, w_progress: float = 10.0, w_deflection: float = 1.0,
                  w_rate: float = 1.0, w_effort: float = 0.1, w_jerk: float = 0.1,
                  w_end_stop: float = 10.0, bonus: float = 50.0,
                  tol_stroke: float = 5e-3, tol_speed: float = 5e-3,

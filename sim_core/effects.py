@@ -119,36 +119,23 @@ class Inertia(Effect):
         sec = ctx.el.section
         kin, wl = ctx.kin, ctx.wl
         Jd = sec.J
-        J_r, J_w = kin.J_r, kin.J_w
+        J_w = kin.J_w
         if sec.has_offset:
-            self._with_offset(ctx, M, F)
-            return
+            # mass centre offset from the reference line (SCENARIOS A1 / paper Table 2): the
+            # translational terms use the mass-centre Jacobian and acceleration
+            J_r, frame, d = _offset_jacobian(ctx)
+        else:
+            J_r = kin.J_r
         if M is not None:
             M += _gram_stacked([(J_r, np.sqrt(wl * sec.rhoA)[:, None].repeat(3, axis=1)),
                                 (J_w, np.sqrt(wl[:, None] * Jd))])
         if ctx.conv is not None:
             omega = J_w @ ctx.qde
             rot = Jd * ctx.conv["w_dot"] + _cross(omega, Jd * omega)
-            F -= _jt_v(J_r, (wl * sec.rhoA)[:, None] * ctx.conv["a"])
-            F -= _jt_v(J_w, wl[:, None] * rot)
-
-    @staticmethod
-    def _with_offset(ctx, M, F):
-        """Mass centre offset from the reference line (SCENARIOS A1 / paper Table 2): the
-        translational terms use the mass-centre Jacobian J_c and acceleration."""
-        sec = ctx.el.section
-        kin, wl = ctx.kin, ctx.wl
-        Jd = sec.J
-        J_w = kin.J_w
-        J_c, frame, d = _offset_jacobian(ctx)
-        if M is not None:
-            M += _gram_stacked([(J_c, np.sqrt(wl * sec.rhoA)[:, None].repeat(3, axis=1)),
-                                (J_w, np.sqrt(wl[:, None] * Jd))])
-        if ctx.conv is not None:
-            omega = J_w @ ctx.qde
-            rot = Jd * ctx.conv["w_dot"] + _cross(omega, Jd * omega)
-            a_c = ctx.conv["a"] + _offset_convective(frame, d, omega, ctx.conv["w_dot"])
-            F -= _jt_v(J_c, (wl * sec.rhoA)[:, None] * a_c)
+            a = ctx.conv["a"]
+            if sec.has_offset:
+                a = a + _offset_convective(frame, d, omega, ctx.conv["w_dot"])
+            F -= _jt_v(J_r, (wl * sec.rhoA)[:, None] * a)
             F -= _jt_v(J_w, wl[:, None] * rot)
 
 

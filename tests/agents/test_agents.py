@@ -1,0 +1,128 @@
+"""agents: scripted schedules reach their targets, the ZV shaper cancels the residual vibration
+of the mode it is tuned to, evaluation is deterministic, and PPO trains and evaluates (smoke)."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from agents import evaluate as ev
+from agents import schedules as S
+from sim_core.validation.closed_form import static_luffing_forces
+
+DT, A_MAX, N = 0.05, 0.25, 600
+
+
+@pytest.mark.parametrize("make", [S.cubic, S.trapezoid, S.zv_trapezoid])
+def test_scripted_schedule_reaches_target_through_env(make):
+    """Every schedule extracts 2 -> 8 m through the env and stops there.  The env integrates the
+    per-step mean acceleration exactly, so the stroke is the trapezoidal integral of v(t): error
+    O(dt^2 * |jump of dv/dt|) at the trapezoid's kinks, (0.05^2 / 12) * 0.25 ~ 5e-5 m per kink;
+    1e-3 m allowed.  The rate must be back to zero up to the float32 rounding of the actions."""
+    s = make()
+    env = ev.make_eval_env()
+    tr = ev.run_episode(env, ev.scripted_policy(s, DT, A_MAX, N), seed=0)
+    m = ev.metrics(tr)
+    assert abs(tr.stroke[-1] - 8.0) < 1e-3
+    # actions pass the env as float32: |dv| <= N dt a_max 2^-24 = 4.5e-7 m/s
+    assert abs(tr.rate[-1]) < N * DT * A_MAX * 2.0 ** -24
+    assert m["time_to_target_s"] is not None and m["time_to_target_s"] <= s.t_end + 1e-9
+    assert m["stop_time_s"] <= s.t_end + 1e-9
+    assert np.all(np.abs(tr.rate) <= 0.5 + 1e-9)      # never exceeds the flow limit
+
+
+def test_schedule_actions_match_rate_profile():
+    """Mean-acceleration actions reproduce v(t) at every step boundary (cumulative sum)."""
+    for s in S.all_schedules():
+        a = s.actions(DT, A_MAX, N) * A_MAX
+        v = np.concatenate([[0.0], np.cumsum(a) * DT])
+        ref = np.array([s.rate(k * DT) for k in range(N + 1)])
+        np.testing.assert_allclose(v, ref, atol=1e-12)
+
+
+def test_schedule_with_too_large_acceleration_is_rejected():
+    with pytest.raises(ValueError, match="a_max"):
+        S.cubic(t_ramp=0.5, t_hold_end=12.0).actions(DT, A_MAX, N)
+
+
+def test_zv_shaper_cancels_residual_vibration_of_its_mode():
+    """Singer-Seering: a linear damped oscillator x'' + 2 zeta w x' + w^2 x = -a(t) driven by the
+    ZV-shaped trapezoid has zero residual vibration after the motion (exactly, for the tuned
+    omega and zeta); the unshaped trapezoid of the same duration leaves a residual of order
+    a / w^2.  Tolerance: residual amplitude < 1e-3 of the unshaped one (integrator rtol 1e-10)."""
+    w, z = S.first_mode()
+    shaped = S.zv_trapezoid()
+    plain = S.trapezoid()
+
+    def residual(s):
+        h = 1e-6
+
+        def acc(t):
+            return (s.rate(t + h) - s.rate(t - h)) / (2 * h)
+        sol = solve_ivp(lambda t, y: [y[1], -acc(t) - 2 * z * w * y[1] - w * w * y[0]],
+                        (0.0, s.t_end), [0.0, 0.0], rtol=1e-10, atol=1e-13, max_step=0.01)
+        x, xd = sol.y[:, -1]
+        return math.hypot(x, xd / w)
+    assert residual(shaped) < 1e-3 * residual(plain)
+
+
+def test_zv_impulses_sum_to_one_and_delay_half_period():
+    w, z = 2.0, 0.05
+    t, A = S.zv_impulses(w, z)
+    assert A.sum() == pytest.approx(1.0, abs=1e-15)
+    assert t[1] == pytest.approx(math.pi / (w * math.sqrt(1 - z * z)), rel=1e-15)
+
+
+def test_force_at_rest_is_the_static_closed_form():
+    """At rest (q = 0, a = 0) the evaluation's telescopic force is the rigid static force of
+    SCENARIOS C7 (closed_form.static_luffing_forces, independent code path, z_c = 0)."""
+    env = ev.make_eval_env()
+    env.reset(seed=0)
+    u = env.unwrapped
+    ref = static_luffing_forces(math.radians(u.angle), u.rom.L, u.payload, z_c=(0.0, 0.0, 0.0))
+    assert ev.telescopic_force(env, 0.0) == pytest.approx(ref.telescopic_force, rel=1e-6)
+
+
+def test_metrics_settle_times():
+    t = np.arange(0, 10.01, 1.0)
+    stroke = np.array([2, 4, 6, 7.995, 8.02, 8.0, 8.0, 8.0, 8.0, 8.0, 8.0])
+    rate = np.array([0, 1, 1, 1, 0.1, 0, 0, 0, 0, 0, 0.0])
+    tr = ev.Trace(t, stroke, rate, 0 * t, 0 * t + 1e-3, 0 * t, 8.0, 0.0)
+    m = ev.metrics(tr)
+    assert m["time_to_target_s"] == 5.0          # 7.995 is inside 1 cm, 8.02 is not
+    assert m["stop_time_s"] == 5.0
+    assert m["residual_tip_rms_m"] == pytest.approx(1e-3)
+
+
+def test_evaluation_is_deterministic():
+    r1, _ = ev.evaluate(None, episodes=1, seed=3)
+    r2, _ = ev.evaluate(None, episodes=1, seed=3)
+    assert json.dumps(r1) == json.dumps(r2)
+
+
+def test_ppo_smoke_train_and_evaluate(tmp_path):
+    """A few hundred PPO steps train, save model + normalisation, and evaluate to finite
+    metrics through the CLI (JSON on stdout, figure written)."""
+    from agents.train_ppo import train
+    path = train(512, seed=1, out=tmp_path / "run", n_envs=1, vec="dummy",
+                 checkpoint_every=0, progress=False, curve_every=100)
+    assert path.exists() and (tmp_path / "run" / "model_vecnormalize.pkl").exists()
+    curve = (tmp_path / "run" / "learning_curve.csv").read_text().splitlines()
+    assert curve[0].startswith("env_steps") and len(curve) >= 2
+    fig = tmp_path / "ev.png"
+    out = tmp_path / "ev.json"
+    assert ev.main(["--model", str(path), "--json", "--figure", str(fig), "--out", str(out)]) == 0
+    res = json.loads(out.read_text())
+    assert set(res) == {"cubic", "trapezoid", "zv_trapezoid", "ppo"}
+    for k in ("final_stroke_error_m", "residual_tip_rms_m", "peak_tip_deflection_m",
+              "peak_telescopic_force_N"):
+        assert math.isfinite(res["ppo"][k])
+    assert fig.stat().st_size > 1000
+    # deterministic policy: same seed, same numbers
+    pol = ev.PPOPolicy(path)
+    env = ev.make_eval_env()
+    a = ev.run_episode(env, pol, 0)
+    b = ev.run_episode(env, pol, 0)
+    np.testing.assert_array_equal(a.stroke, b.stroke)
