@@ -169,15 +169,23 @@ class PPOPolicy:
         meta = Path(model_path).with_name(Path(model_path).stem + "_meta.json")
         if not meta.exists():
             meta = Path(model_path).with_name("model_meta.json")
-        self.du_max = None
+        self.du_max, self.repeat, self._held = None, 1, 0.0
         if meta.exists():
-            self.du_max = json.loads(meta.read_text()).get("du_max")
+            info = json.loads(meta.read_text())
+            self.du_max = info.get("du_max")
+            self.repeat = int(info.get("action_repeat") or 1)
         if vecnorm_path.exists():
             with open(vecnorm_path, "rb") as f:
                 vn = pickle.load(f)
             self.obs_rms, self.clip_obs, self.eps = vn.obs_rms, vn.clip_obs, vn.epsilon
 
     def __call__(self, obs: np.ndarray, k: int) -> float:
+        if k % self.repeat:                # agents.wrappers.ActionRepeat: zero-order hold
+            return self._held
+        self._held = self._act(obs)
+        return self._held
+
+    def _act(self, obs: np.ndarray) -> float:
         x = np.asarray(obs, dtype=np.float64)
         if self.obs_rms is not None:
             x = np.clip((x - self.obs_rms.mean) / np.sqrt(self.obs_rms.var + self.eps),

@@ -52,7 +52,7 @@ TRAIN_ENV_KWARGS = dict(tol_deflection=1e-3, tol_deflection_rate=1e-2, w_deflect
 
 
 def _make_env(rank: int, seed: int, du_max: float | None, env_kwargs: dict,
-              random_start: float = 0.0):
+              random_start: float = 0.0, action_repeat: int = 1):
     def thunk():
         import gymnasium as gym
         from stable_baselines3.common.monitor import Monitor
@@ -65,6 +65,9 @@ def _make_env(rank: int, seed: int, du_max: float | None, env_kwargs: dict,
         if du_max:
             from .wrappers import AccelerationIncrement
             env = AccelerationIncrement(env, du_max)
+        if action_repeat > 1:
+            from .wrappers import ActionRepeat
+            env = ActionRepeat(env, action_repeat)
         env = Monitor(env, info_keywords=("success",))
         env.reset(seed=seed + rank)
         env.action_space.seed(seed + rank)
@@ -122,7 +125,7 @@ def train(timesteps: int, seed: int, out: str | os.PathLike, n_envs: int | None 
           progress: bool = True, curve_every: int = 5_000, verbose: int = 0,
           hyper_overrides: dict | None = None, policy_overrides: dict | None = None,
           du_max: float | None = None, env_kwargs: dict | None = None,
-          random_start: float = 0.0) -> Path:
+          random_start: float = 0.0, action_repeat: int = 1) -> Path:
     """Train and save; returns the path of the saved model."""
     import torch
     from stable_baselines3 import PPO
@@ -143,7 +146,10 @@ def train(timesteps: int, seed: int, out: str | os.PathLike, n_envs: int | None 
     torch.set_num_threads(1)
     set_random_seed(seed)
     env_kwargs = dict(TRAIN_ENV_KWARGS if env_kwargs is None else env_kwargs)
-    fns = [_make_env(i, seed, du_max, env_kwargs, random_start) for i in range(n_envs)]
+    if du_max and action_repeat > 1:
+        raise ValueError("du_max with action_repeat > 1: choose one action parameterisation")
+    fns = [_make_env(i, seed, du_max, env_kwargs, random_start, action_repeat)
+           for i in range(n_envs)]
     venv = SubprocVecEnv(fns, start_method="spawn") if vec == "subproc" and n_envs > 1 else DummyVecEnv(fns)
     venv.seed(seed)
     venv = VecNormalize(venv, norm_obs=True, norm_reward=True, gamma=HYPER["gamma"], clip_obs=10.0)
@@ -175,7 +181,8 @@ def train(timesteps: int, seed: int, out: str | os.PathLike, n_envs: int | None 
         import json
         (out / "model_meta.json").write_text(json.dumps(
             {"env_id": ENV_ID, "action_mode": "increment" if du_max else "acceleration",
-             "du_max": du_max, "env_kwargs": env_kwargs, "random_start": random_start,
+             "du_max": du_max, "action_repeat": action_repeat, "env_kwargs": env_kwargs,
+             "random_start": random_start,
              "seed": seed, "timesteps": int(model.num_timesteps)}) + "\n")
         (out / "train_info.txt").write_text(
             f"timesteps {model.num_timesteps}\nseed {seed}\nn_envs {n_envs}\nvec {vec}\n"
@@ -203,6 +210,9 @@ def main(argv=None) -> int:
     ap.add_argument("--random-start", type=float, default=0.5,
                     help="fraction of training episodes started at a random piston length "
                          "(agents.wrappers.RandomStart; default 0.5, 0 = off)")
+    ap.add_argument("--action-repeat", type=int, default=1,
+                    help="hold each policy action for K env steps (agents.wrappers.ActionRepeat; "
+                         "control period K x 0.05 s; default 1)")
     ap.add_argument("--env-set", action="append", default=[], metavar="KEY=VALUE",
                     help="training-env constructor argument (replaces the defaults "
                          f"{TRAIN_ENV_KWARGS}); repeatable")
@@ -230,7 +240,7 @@ def main(argv=None) -> int:
     path = train(args.timesteps, args.seed, args.out, args.n_envs, args.vec, args.tensorboard,
                  args.checkpoint_every, not args.no_progress, hyper_overrides=over,
                  policy_overrides=pol, du_max=args.du_max, env_kwargs=env_kwargs,
-                 random_start=args.random_start)
+                 random_start=args.random_start, action_repeat=args.action_repeat)
     print(f"saved {path}")
     return 0
 

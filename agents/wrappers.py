@@ -65,3 +65,30 @@ class RandomStart(gym.Wrapper):
         if "stroke_start" not in options and rng.uniform() < self.p:
             options["stroke_start"] = float(rng.uniform(self.lo, self.hi))
         return self.env.reset(options=options)
+
+
+class ActionRepeat(gym.Wrapper):
+    """The policy acts every ``repeat`` env steps: its action is held (zero-order hold) for
+    repeat * dt seconds (4 x 0.05 s = 0.2 s by default) and the rewards of those steps are
+    summed, so the undiscounted episode return is the env's.  A 30 s episode is then 150
+    decisions instead of 600: the credit for stopping at the target is 4x fewer decisions
+    away, and each training step carries 4x more simulated time (the env is cheap next to the
+    PPO update).  The held command is well inside the bandwidth that matters: the first
+    bending mode is 0.4-1.2 Hz (period >= 0.8 s) and the tip responds to the acceleration
+    steps' jerk either way.  Evaluation holds the action the same way
+    (``agents.evaluate.PPOPolicy``, meta ``action_repeat``)."""
+
+    def __init__(self, env: gym.Env, repeat: int = 4):
+        super().__init__(env)
+        if int(repeat) != repeat or repeat < 1:
+            raise ValueError(f"repeat = {repeat!r}: allowed integers >= 1")
+        self.repeat = int(repeat)
+
+    def step(self, action):
+        total = 0.0
+        for _ in range(self.repeat):
+            obs, r, term, trunc, info = self.env.step(action)
+            total += float(r)
+            if term or trunc:
+                break
+        return obs, total, term, trunc, info

@@ -542,7 +542,8 @@ def angular_momentum(fs: FoldingSystem, Q: np.ndarray, Qd: np.ndarray) -> np.nda
 
 
 def simulate_folding(p: FoldingParams, t_end: float = 45.0, n_output: int = 451,
-                     rtol: float = 1e-6, atol: float = 1e-8, progress=None, max_step=None):
+                     rtol: float = 1e-6, atol: float = 1e-8, progress=None, max_step=None,
+                     max_wall_s=None):
     """Run the folding scene from its static equilibrium; Result with tip_position,
     tip_velocity (boom-2 tip, m, m/s), cylinder_forces (N, pushing positive, one column per
     cylinder), cylinder_lengths (m), slew_angle (rad), boom_angles (boom-1 elevation and
@@ -561,6 +562,8 @@ def simulate_folding(p: FoldingParams, t_end: float = 45.0, n_output: int = 451,
     sol = {"rtol": rtol, "atol": atol, "n_output": n_output}
     if max_step:
         sol["max_step"] = max_step
+    if max_wall_s:
+        sol["max_wall_s"] = max_wall_s
     return run_with_partial(lambda: integrate_rk45(m, y0, t_end, sol, progress),
                             lambda t, ys, st, err: folding_result(fs, t, ys, st, err))
 

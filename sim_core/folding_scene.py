@@ -38,7 +38,8 @@ def validate_folding(raw: dict, source: str) -> dict[str, Any]:
     sc: dict[str, Any] = {"kind": "folding", "name": str(raw.get("name", "folding")),
                           "description": str(raw.get("description", "")), "source": source}
     s = raw.get("solver", {})
-    check_keys(s, {"t_end", "rtol", "atol", "n_output", "method", "max_step"}, "solver")
+    check_keys(s, {"t_end", "rtol", "atol", "n_output", "method", "max_step", "max_wall_s"},
+               "solver")
     sc["solver"] = {"t_end": number(s, "t_end", "solver", 45.0, lo=0.0, lo_open=True),
                     "rtol": number(s, "rtol", "solver", 1e-6, lo=0.0, hi=1.0, lo_open=True,
                                    hi_open=True),
@@ -47,6 +48,8 @@ def validate_folding(raw: dict, source: str) -> dict[str, Any]:
                     "method": choice(s, "method", "solver", ("RK45",), "RK45")}
     if "max_step" in s:
         sc["solver"]["max_step"] = number(s, "max_step", "solver", lo=0.0, lo_open=True)
+    if "max_wall_s" in s:
+        sc["solver"]["max_wall_s"] = number(s, "max_wall_s", "solver", lo=0.0, lo_open=True)
     b = raw.get("booms", {})
     check_keys(b, {"length", "radius", "mass_per_length", "E", "nu", "n_nodes", "n_gauss"}, "booms")
     sc["booms"] = {"length": number(b, "length", "booms", 12.0, lo=1.0, lo_open=True),

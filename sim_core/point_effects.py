@@ -49,6 +49,8 @@ class RopeDrive:
     L0: float
     slack_width: float = 1e-6
     name: str = "rope"
+    bilateral: bool = False     # statics only: T = (EA/L0)(l - L0) of either sign (see
+                                # telescopic.initial_equilibrium); never in dynamics
 
     def length(self, Q):
         pts = [p(Q) for p in self.points]
@@ -62,8 +64,10 @@ class RopeDrive:
         return ell, grad
 
     def tension(self, ell):
-        x = (ell - self.L0) / self.slack_width
         k = self.EA / self.L0
+        if self.bilateral:
+            return k * (ell - self.L0)
+        x = (ell - self.L0) / self.slack_width
         if x <= 0:
             return 0.0
         if x >= 1:

@@ -10,7 +10,8 @@ an error names the dotted field, the value and the allowed range
 Beam-scene schema (units):
   name, description
   [solver]   t_end s (> 0), method ("RK45"), rtol (0, 1), atol (> 0), n_output (>= 2),
-             max_step s (> 0, optional)
+             max_step s (> 0, optional), max_wall_s s (> 0, optional: wall-clock budget; the
+             run stops there with a SimulationError and a partial result)
   [effects]  gravity, torsion, filtering: booleans (what is off is not computed)
   [filtering] h s (> 0): stress-averaging window (second seed Eq. 53)
   [gravity]  g m/s^2 (3-vector)
@@ -228,7 +229,7 @@ def choice(table: dict, key: str, where: str, allowed: tuple[str, ...], default=
 
 _TOP = {"name", "description", "solver", "effects", "filtering", "gravity", "beams",
         "boundary", "point_loads", "initial", "notes"}
-_SOLVER = {"t_end", "method", "rtol", "atol", "n_output", "max_step"}
+_SOLVER = {"t_end", "method", "rtol", "atol", "n_output", "max_step", "max_wall_s"}
 _EFFECTS = {"gravity", "torsion", "filtering"}
 _BEAM = {"name", "length", "breakpoints", "n_nodes", "n_gauss", "origin", "direction", "section"}
 _SECTION = {"E", "G", "rho", "A", "I_t", "I_b", "J", "I_p", "rotary_bending"}
@@ -257,6 +258,8 @@ def validate(raw: dict, source: str = "<scene>") -> dict:
     }
     if "max_step" in s:
         solver["max_step"] = number(s, "max_step", "solver", lo=0.0, lo_open=True)
+    if "max_wall_s" in s:
+        solver["max_wall_s"] = number(s, "max_wall_s", "solver", lo=0.0, lo_open=True)
     sc["solver"] = solver
     t_end = solver["t_end"]
 

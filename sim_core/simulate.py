@@ -61,7 +61,9 @@ class _CountingRHS:
 def integrate_rk45(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
     """Explicit RK45 (scipy's Dormand-Prince stepper) on model.rhs with dense output at
     ``sol["n_output"]`` equally spaced times.  Returns (t, y, stats); raises SimulationError with
-    the time, step and last good state on failure or non-finite values."""
+    the time, step and last good state on failure or non-finite values, or when the optional
+    wall-clock budget ``sol["max_wall_s"]`` (s) is exhausted (the outputs reached so far are
+    attached, so a budgeted run still yields a partial result)."""
     t_eval = np.linspace(0.0, t_end, sol["n_output"])
     rhs = _CountingRHS(model)
     kwargs = {"max_step": sol["max_step"]} if "max_step" in sol else {}
@@ -95,6 +97,12 @@ def integrate_rk45(model, y0: np.ndarray, t_end: float, sol: dict, progress=None
                     k_out += 1
             if progress is not None:
                 progress(solver.t, time.perf_counter() - wall0)
+            budget = sol.get("max_wall_s")
+            if budget is not None and solver.status == "running" \
+                    and time.perf_counter() - wall0 > budget:
+                raise SimulationError(solver.t, f"wall-clock budget solver.max_wall_s = {budget:g} s "
+                                      f"exhausted (last step {solver.step_size:.3g} s)",
+                                      step=solver.step_size, last_state=solver.y)
     except SimulationError as exc:
         # keep what was computed: the caller turns it into a partial Result (exc.result)
         exc.partial = (t_eval[:len(ys)], np.array(ys), stats())
@@ -134,7 +142,7 @@ def simulate(scene: dict, progress=None) -> Result:
             res.scene = scene
             return res
         res = simulate_telescopic(params_from_scene(scene), sol["t_end"], sol["n_output"],
-                                  sol["rtol"], sol["atol"], progress)
+                                  sol["rtol"], sol["atol"], progress, sol.get("max_wall_s"))
         res.scene = scene
         return res
     if scene.get("kind") == "folding":
@@ -142,7 +150,8 @@ def simulate(scene: dict, progress=None) -> Result:
         from .folding_scene import params_from_scene as folding_params
         sol = scene["solver"]
         res = simulate_folding(folding_params(scene), sol["t_end"], sol["n_output"],
-                               sol["rtol"], sol["atol"], progress, sol.get("max_step"))
+                               sol["rtol"], sol["atol"], progress, sol.get("max_step"),
+                               sol.get("max_wall_s"))
         res.scene = scene
         return res
     model, Q0, Qd0 = build_model(scene)

@@ -270,22 +270,64 @@ def initial_equilibrium(ts: TelescopicSystem, t: float = 0.0):
     """Static equilibrium at t = 0 with the rope lengths of SCENARIOS A3: the retraction rope is
     'just taut' *at the equilibrium*: it is slack while the equilibrium is solved, then its
     unstretched length is set to its length there (zero tension, no change of the equilibrium).
-    Returns (z, lambda)."""
+    Returns (z, lambda).
+
+    Two-rope statics (our reading, issue 6): when the static extraction-rope tension T0 =
+    (m3 + m_p) g sin(theta) (C7) is not clearly in the rope's stiff branch (T0 <= (EA/L0) *
+    slack_width, e.g. payload 0 at 0 deg), both tension-only ropes would sit at their kink with
+    zero axial stiffness and boom 3's axial position is undetermined (Newton stalled at |r| ~
+    0.3 N).  Then the equilibrium is solved with the extraction rope *bilateral* (a linear spring
+    of either sign: the pair of opposing ropes acts as one rope), and afterwards the rope that
+    carries the load is given that tension and the other one is made just taut at the start of
+    its stiff branch (tension (EA/L0) slack_width / 2, ~5 N at the paper's EA); a final
+    tension-only Newton from there leaves both ropes taut and the equilibrium well posed."""
     from .statics import constrained_static_equilibrium
     m = ts.model
     z0, _ = m.reduced_state(t, ts.Q0, np.zeros_like(ts.Q0))
-    retr = [pe for pe in m.point_effects if pe.name == "retraction_rope"]
-    for r in retr:
-        r.L0 = np.inf
-    z, lam = constrained_static_equilibrium(m, z0, t)
-    Q, _ = m.full_state(t, z, np.zeros_like(z))
-    for r in retr:
-        r.L0 = float(r.length(Q)[0])
-    return z, lam
+    ropes = {pe.name: pe for pe in m.point_effects if isinstance(pe, RopeDrive)}
+    ext, retr = ropes.get("extraction_rope"), ropes.get("retraction_rope")
+    if retr is not None:
+        retr.L0 = np.inf
+    if ext is None or retr is None:
+        return constrained_static_equilibrium(m, z0, t)
+
+    def length(rope, z):
+        Q, _ = m.full_state(t, z, np.zeros_like(z))
+        return float(rope.length(Q)[0])
+
+    def taut_L0(rope, ell, T):
+        """Unstretched length with tension-only tension T >= (EA/L0) s / 2 at length ell:
+        (EA/L0)(ell - L0 - s/2) = T."""
+        return rope.EA * (ell - 0.5 * rope.slack_width) / (rope.EA + T)
+
+    k_e = ext.EA / ext.L0
+    if ext.tension(length(ext, z0)) > k_e * ext.slack_width:       # stiff branch: as A3 says
+        z, lam = constrained_static_equilibrium(m, z0, t)
+        retr.L0 = length(retr, z)
+        return z, lam
+    ext.bilateral = True
+    try:
+        z, lam = constrained_static_equilibrium(m, z0, t)
+        T = ext.tension(length(ext, z))
+    finally:
+        ext.bilateral = False
+    s = ext.slack_width
+    ell_e, ell_r = length(ext, z), length(retr, z)
+    if T >= k_e * s:
+        # the extraction rope carries T in its stiff branch: same forces, nothing to re-solve
+        ext.L0 = taut_L0(ext, ell_e, T)
+        retr.L0 = ell_r
+        return z, lam
+    # near zero or compressive: both ropes taut (the net pull T shared as T_min + max(+-T, 0))
+    T_min = 0.5 * k_e * s
+    ext.L0 = taut_L0(ext, ell_e, T_min + max(T, 0.0))
+    retr.L0 = taut_L0(retr, ell_r, T_min + max(-T, 0.0))
+    return constrained_static_equilibrium(m, z, t)
 
 
 def simulate_telescopic(p: TelescopicParams, t_end: float = 20.0, n_output: int = 201,
-                        rtol: float = 1e-6, atol: float = 1e-7, progress=None):
+                        rtol: float = 1e-6, atol: float = 1e-7, progress=None,
+                        max_wall_s: float | None = None):
     """Run the telescopic scene from its static equilibrium and return a Result with the
     public outputs of the telescopic contract (tip kinematics, piston stroke, cylinder forces,
     contact-point resultants, contact coordinates, constraint violation; with friction also the
@@ -300,8 +342,8 @@ def simulate_telescopic(p: TelescopicParams, t_end: float = 20.0, n_output: int 
     z0, _ = initial_equilibrium(ts)
     y0 = np.concatenate([z0, 0 * z0])
     return run_with_partial(
-        lambda: integrate_rk45(m, y0, t_end, {"rtol": rtol, "atol": atol, "n_output": n_output},
-                               progress),
+        lambda: integrate_rk45(m, y0, t_end, {"rtol": rtol, "atol": atol, "n_output": n_output,
+                                              "max_wall_s": max_wall_s}, progress),
         lambda t, ys, stats, err: _telescopic_result(ts, t, ys, stats, err))
 
 

@@ -126,3 +126,43 @@ def test_ppo_smoke_train_and_evaluate(tmp_path):
     a = ev.run_episode(env, pol, 0)
     b = ev.run_episode(env, pol, 0)
     np.testing.assert_array_equal(a.stroke, b.stroke)
+
+
+def test_action_repeat_is_a_zero_order_hold_of_the_env():
+    """ActionRepeat(k) is exactly k env steps with the same action and the summed reward; the
+    evaluation policy holds its action for k steps (meta action_repeat)."""
+    import gymnasium as gym
+
+    import boom_env  # noqa: F401
+    from agents.wrappers import ActionRepeat
+    a = np.array([0.7], dtype=np.float32)
+    env = gym.make("boom_env/TelescopicExtraction-v0")
+    rep = ActionRepeat(gym.make("boom_env/TelescopicExtraction-v0"), 4)
+    env.reset(seed=5)
+    rep.reset(seed=5)
+    for _ in range(3):
+        total = 0.0
+        for _ in range(4):
+            obs, r, *_ = env.step(a)
+            total += r
+        obs_r, r_r, *_ = rep.step(a)
+        np.testing.assert_array_equal(obs, obs_r)
+        assert r_r == pytest.approx(total, rel=1e-12, abs=1e-12)
+    with pytest.raises(ValueError, match="repeat"):
+        ActionRepeat(env, 0)
+
+
+def test_ppo_policy_holds_its_action(tmp_path):
+    from agents.train_ppo import train
+    path = train(256, seed=2, out=tmp_path / "run", n_envs=1, vec="dummy", checkpoint_every=0,
+                 progress=False, action_repeat=4)
+    meta = json.loads((tmp_path / "run" / "model_meta.json").read_text())
+    assert meta["action_repeat"] == 4
+    pol = ev.PPOPolicy(path)
+    env = ev.make_eval_env()
+    obs, _ = env.reset(seed=0)
+    acts = []
+    for k in range(8):
+        acts.append(pol(obs, k))
+        obs, *_ = env.step(np.array([acts[-1]], dtype=np.float32))
+    assert acts[0] == acts[1] == acts[2] == acts[3] and acts[4] == acts[5] == acts[6] == acts[7]

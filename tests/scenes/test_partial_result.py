@@ -54,3 +54,40 @@ def test_failed_stage_evaluation_is_retried_with_a_smaller_step(monkeypatch):
     # fail too (counted), but every such step is rejected
     assert res.stats["n_failed_rhs"] >= 3
     assert np.all(np.isfinite(res["tip_position"]))
+
+
+def test_wall_clock_budget_stops_with_a_partial_result(monkeypatch, tmp_path):
+    """solver.max_wall_s: the run stops once the budget is spent, with the typed error naming
+    the budget and the outputs reached so far (saved by the CLI, exit status 3)."""
+    import time
+
+    from sim_core.cli import main
+    from sim_core.result import Result
+    original = Model.rhs
+
+    def slow_rhs(self, t, y):
+        time.sleep(0.002)               # a deterministic wall-clock cost per evaluation
+        return original(self, t, y)
+
+    monkeypatch.setattr(Model, "rhs", slow_rhs)
+    over = {"solver.t_end": 0.01, "solver.n_output": 11, "effects.filtering": False,
+            "beams.0.n_nodes": 5, "initial.static_equilibrium": False,
+            "solver.max_wall_s": 0.05}
+    with pytest.raises(SimulationError) as info:
+        simulate(load_scene("beam_through_sleeve", overrides=over))
+    exc = info.value
+    assert "max_wall_s" in exc.reason and 0.0 < exc.t < 0.01
+    assert exc.result is not None and len(exc.result.t) < 11
+    sets = [a for k, v in over.items()
+            for a in ("--set", f"{k}={str(v).lower() if isinstance(v, bool) else v}")]
+    code = main(["run", "beam_through_sleeve", *sets, "--out", str(tmp_path), "--quiet"])
+    assert code == 3
+    part = Result.load(tmp_path / "result.npz")
+    assert part.error and "max_wall_s" in part.error
+
+
+def test_wall_clock_budget_is_validated():
+    from sim_core.errors import SceneError
+    for name in ("beam_through_sleeve", "telescopic_extraction", "folding_boom"):
+        with pytest.raises(SceneError, match="max_wall_s"):
+            load_scene(name, overrides={"solver.max_wall_s": -1.0})

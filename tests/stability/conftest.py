@@ -16,6 +16,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from sim_core.energy_audit import AuditedSystem
+from sim_core.energy_audit import mechanical_energy as _mechanical_energy
 from sim_core.simulate import integrate_rk45, run_with_partial
 from sim_core.telescopic import (TelescopicParams, _telescopic_result, build_telescopic,
                                  initial_equilibrium)
@@ -66,34 +68,13 @@ def build_undeformed(p: TelescopicParams, target=None):
     return ts, np.concatenate([z0, np.zeros_like(z0)])
 
 
-def rope_energy(rope, ell: float) -> float:
-    """Strain energy (J) of a RopeDrive at length ell: the integral of its C1-ramp tension law."""
-    w, k = rope.slack_width, rope.EA / rope.L0
-    d = ell - rope.L0
-    if d <= 0.0:
-        return 0.0
-    if d <= w:
-        return k * d ** 3 / (6.0 * w)
-    return k * w * w / 6.0 + k * (0.5 * (d * d - w * w) - 0.5 * w * (d - w))
-
-
 def mechanical_energy(ts, t: float, y: np.ndarray) -> float:
-    """Kinetic + strain + gravity energy of the booms, payload point mass and rope strain (J).
-    The stress filter's rate terms are not included: with the filter on, a run from rest has
-    E(t) - E(0) <= W (the filter's inertia-like term is >= 0 and its damping term dissipates)."""
-    m, p = ts.model, ts.params
-    n = m.n_dof
-    Q, Qd = m.full_state(t, y[:n], y[n:])
-    g = np.array([0.0, 0.0, -p.gravity])
-    en = m.energies(t, Q, Qd, g)
-    E = en["T"] + en["U"] + en["V"]
-    r, J, _, _ = ts.tip(Q)
-    v = J @ Qd
-    E += 0.5 * p.payload * float(v @ v) - p.payload * float(r @ g)
-    for pe in m.point_effects:
-        if hasattr(pe, "L0"):
-            E += rope_energy(pe, float(np.real(pe.length(Q)[0])))
-    return float(np.real(E))
+    """Kinetic + strain + gravity energy of the booms, payload point mass and rope strain (J)
+    (sim_core.energy_audit.mechanical_energy).  The stress filter's rate terms are not included:
+    with the filter on, a run from rest has E(t) - E(0) <= W (the filter's inertia-like term is
+    >= 0 and its damping term dissipates)."""
+    n = ts.model.n_dof
+    return _mechanical_energy(ts, t, y[:n], y[n:])
 
 
 class StepCollapse(AssertionError):
@@ -105,23 +86,23 @@ def run_window(ts, y0, t_end: float, n_output: int = 21, rtol: float = 1e-6, ato
                energy: bool = False, step_floor: float | None = None):
     """Integrate ts from y0 over [0, t_end] (RK45 of sim_core) and return the Result (outputs of
     the telescopic contract).  With ``energy``: also outputs ``energy`` (J, mechanical energy
-    incl. payload and ropes) and ``cylinder_work`` (J, cumulative trapezoidal work of the
-    telescopic cylinder: its multiplier times the prescribed rate; with this model's sign
-    convention the multiplier is the pushing force, positive in an extraction against gravity).  A SimulationError propagates with its partial result attached.  With
-    ``step_floor``: raises StepCollapse at the first accepted step shorter than the floor (the
-    final step, cut to land on t_end, excepted)."""
+    incl. payload and ropes) and ``cylinder_work`` (J, the work of the telescopic cylinder, its
+    multiplier times the prescribed rate, integrated as an extra state of the same RK45 run:
+    sim_core.energy_audit; with this model's sign convention the multiplier is the pushing
+    force, positive in an extraction against gravity).  A SimulationError propagates with its
+    partial result attached.  With ``step_floor``: raises StepCollapse at the first accepted
+    step shorter than the floor (the final step, cut to land on t_end, excepted)."""
     m = ts.model
+    n = m.n_dof
     sol = {"rtol": rtol, "atol": atol, "n_output": n_output}
-    cyl = next(c for c in m.nonlinear if c.name == "telescopic_cylinder")
+    audited = AuditedSystem(ts, ("drive_work",)) if energy else None
 
     def collect(t, ys, stats, err):
-        res = _telescopic_result(ts, t, ys, stats, err)
+        res = _telescopic_result(ts, t, ys[:, :2 * n], stats, err)
         if energy:
-            res.outputs["energy"] = np.array([mechanical_energy(ts, tk, y) for tk, y in zip(t, ys)])
-            rate = np.array([cyl.target(tk)[1] for tk in t], dtype=float).reshape(len(t), -1)[:, 0]
-            power = res["telescopic_cylinder_force"] * rate
-            res.outputs["cylinder_work"] = np.concatenate(
-                [[0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(t))])
+            res.outputs["energy"] = np.array([mechanical_energy(ts, tk, y[:2 * n])
+                                              for tk, y in zip(t, ys)])
+            res.outputs["cylinder_work"] = ys[:, 2 * n]
         return res
 
     last = [0.0]
@@ -133,6 +114,8 @@ def run_window(ts, y0, t_end: float, n_output: int = 21, rtol: float = 1e-6, ato
             raise StepCollapse(f"accepted RK45 step {h:.3g} s < floor {step_floor:g} s at "
                                f"t = {t:.6g} s (wall {wall:.1f} s)")
 
+    if energy:
+        return run_with_partial(lambda: audited.integrate(y0, t_end, sol, watch), collect)
     return run_with_partial(lambda: integrate_rk45(m, y0, t_end, sol, watch), collect)
 
 

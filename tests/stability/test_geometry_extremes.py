@@ -17,11 +17,10 @@ so the explicit step, and it only dissipates: from rest E(t) - E(0) <= W_cylinde
 import numpy as np
 import pytest
 
-from sim_core.errors import SimulationError
 from sim_core.telescopic import TelescopicParams
 
 from .conftest import assert_no_energy_created, assert_stable, build_at_equilibrium, run_window
-from .thresholds import CONSTRAINT_TOL, MIN_ELEMENT_LENGTH, MIN_STEP_FRICTIONLESS
+from .thresholds import MIN_ELEMENT_LENGTH, MIN_STEP_FRICTIONLESS, constraint_tol
 
 L = 10.0
 SOFT_CROSSING = dict(n_nodes=3, E=2.1e10, payload=25000.0, luffing_angle_deg=80.0, stroke0=4.95,
@@ -44,9 +43,10 @@ def run_case(kw, t_end, n_out):
     p = TelescopicParams(**kw, contact_distribution=False)
     ts, y0 = build_at_equilibrium(p)
     res = run_window(ts, y0, t_end, n_out, energy=True)
-    assert_stable(res, MIN_STEP_FRICTIONLESS, CONSTRAINT_TOL)
+    tol = constraint_tol(float(np.max(np.linalg.norm(res["tip_position"], axis=1))))
+    assert_stable(res, MIN_STEP_FRICTIONLESS, tol)
     energy_balanced(ts, res)
-    return p, res
+    return p, res, tol
 
 
 def _element_lengths_positive(res):
@@ -56,19 +56,13 @@ def _element_lengths_positive(res):
     assert np.min(s2) > 0.0 and np.max(s2) < L
 
 
-STIFF_EQUILIBRIUM_FAILS = (
-    "initial_equilibrium raises SimulationError at E = 2.1e12 Pa, payload 0, 0 deg, L_s = 9.6 m: "
-    "'constrained static equilibrium: Newton did not converge (|r| = 0.309 N, |phi| = 1.78e-14)' "
-    "(measured; the residual stalls above the solver's relative tolerance)")
-
-
 @pytest.mark.slow
 def test_contact_points_pass_each_other_soft_heavy_steep():
     """4.95 -> 5.25 m at 0.5 m/s: s_2,2 - s_3,2 changes sign, no blow-up, energy balanced.
     (With E = 2.1e10 the ropes' EA scales to 1e7 N: boom 3 lags the piston by centimetres, so a
     0.1 m stroke did not carry s_2,2 past s_3,2 - measured -0.04 m at 5.05 m; 0.3 m does by the
     geometry, not yet re-measured.)"""
-    p, res = run_case(SOFT_CROSSING, 0.75, 31)
+    p, res, tol = run_case(SOFT_CROSSING, 0.75, 31)
     stroke = p.stroke0 + res["piston_stroke"]
     assert stroke[0] < 5.0 < stroke[-1]
     gap = res["inner_contact_s"][:, 1] - res["outer_contact_s"][:, 0]   # s_2,2 - s_3,2
@@ -77,23 +71,33 @@ def test_contact_points_pass_each_other_soft_heavy_steep():
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, raises=SimulationError, reason=STIFF_EQUILIBRIUM_FAILS)
 def test_full_extension_to_the_end_stop_stiff_unloaded_horizontal():
     """9.6 -> 9.9 m (0.1 m short of the geometric limit): element [0, s_3] shrinks to 0.1 m."""
-    p, res = run_case(STIFF_EXTENSION, 0.7, 36)
+    p, res, tol = run_case(STIFF_EXTENSION, 0.7, 36)
     stroke = p.stroke0 + res["piston_stroke"]
-    assert stroke[-1] == pytest.approx(9.9, abs=1e-6)
-    assert np.min(res["outer_contact_s"]) == pytest.approx(L - 9.9, abs=1e-3)
+    assert stroke[-1] == pytest.approx(9.9, abs=tol)      # the driver row's violation
+    # boom 2's outer contact node is tied to the piston (s_3,2 = L - L_s); boom 3 follows on its
+    # elastic ropes and may surge about that (see test_full_retraction_to_the_end_stop)
+    assert np.min(res["outer_contact_s"][:, 0]) == pytest.approx(L - 9.9, abs=1e-3)
     _element_lengths_positive(res)
 
 
 @pytest.mark.slow
 def test_full_retraction_to_the_end_stop():
-    """0.5 -> 0.1 m on the paper's scene: element [s_3, L] shrinks to 0.1 m."""
-    p, res = run_case(PAPER_RETRACTION, 1.0, 51)
+    """0.5 -> 0.1 m on the paper's scene: element [s_3, L] of boom 2 shrinks to 0.1 m.
+
+    Boom 3 hangs on its elastic extraction rope (k ~ EA / 18 m = 5.5e6 N/m) with the 25 t
+    payload: the 0.1 s ramps (5 m/s^2) excite the rope-payload surge (~2.3 Hz), so boom 3's
+    relative stroke swings by up to ~0.1 m about boom 2's (measured: it ends at 5 mm, its
+    element [s_3, L] at 5.4 mm, s_3,3 = 9.9946 m).  The model has no mechanical end stop for
+    boom 3 (a real crane would hit one); the check here is that the shrinking elements stay
+    positive and the run stays stable and energy-consistent."""
+    p, res, tol = run_case(PAPER_RETRACTION, 1.0, 51)
     stroke = p.stroke0 + res["piston_stroke"]
-    assert stroke[-1] == pytest.approx(0.1, abs=1e-6)
-    assert np.max(res["outer_contact_s"]) == pytest.approx(L - 0.1, abs=1e-3)
+    assert stroke[-1] == pytest.approx(0.1, abs=tol)      # the driver row's violation
+    # s_3,2 is where boom 1's tip meets boom 2: L - L_s up to the shift from the booms' bending
+    # and the radial offsets (25 t at 60 deg: measured +2.8 mm at the start, +3.9 mm at the end)
+    assert np.max(res["outer_contact_s"][:, 0]) == pytest.approx(L - 0.1, abs=1e-2)
     _element_lengths_positive(res)
 
 
@@ -102,7 +106,7 @@ def test_crossing_at_paper_speed_paper_scene():
     """The paper's scene (E = 2.1e11, 25 t, 60 deg) through 5 m: 4.9 -> 5.1 m."""
     kw = dict(n_nodes=3, E=2.1e11, payload=25000.0, luffing_angle_deg=60.0, stroke0=4.9,
               v_max=0.5, t_ramp=0.2, t_hold_end=0.4)
-    p, res = run_case(kw, 0.7, 36)
+    p, res, tol = run_case(kw, 0.7, 36)
     gap = res["inner_contact_s"][:, 1] - res["outer_contact_s"][:, 0]
     assert gap[0] < 0.0 < gap[-1]
     _element_lengths_positive(res)

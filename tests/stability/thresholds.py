@@ -30,6 +30,19 @@ MIN_STEP_FRICTION = 1e-5              # s
 # Units: m for point coincidences, rad for angle rows, m for the drivers.
 CONSTRAINT_TOL = 1e-6
 
+
+def constraint_tol(extent_m: float, rtol: float = 1e-6, atol: float = 1e-7) -> float:
+    """Violation bound (m) for the geometry extremes (end stops, contact points passing), where
+    a spline element shrinks to 0.1 m and its high frequencies work the explicit integrator
+    hardest: RK45 bounds the *RMS* of the scaled local errors, so a single coordinate may take
+    up to atol + rtol * |q| per step and more (|q| up to extent_m, the largest tip distance from
+    the pivot, ~30 m fully extended); Baumgarte (xi = 10 1/s) removes drift on 1/xi = 0.1 s, i.e.
+    ~10 steps of ~10 ms can accumulate.  Bound: 10 (atol + rtol extent_m) (1.2e-4 m at 12 m) - a
+    stability criterion (a drifting or blowing-up run exceeds it by decades; measured 1e-6 -
+    3e-6 m in these runs, against 1e-10 - 1e-7 m in normal operation, see CONSTRAINT_TOL)."""
+    return 10.0 * (atol + rtol * extent_m)
+
+
 # ---------------------------------------------------------------- energy balance
 # The runs keep the paper's stress filter (h = 0.01 s): it adds (h^2/6) int B'DB to the mass
 # matrix, which caps the highest frequencies near sqrt(6)/h ~ 245 rad/s and so the explicit
@@ -41,9 +54,10 @@ CONSTRAINT_TOL = 1e-6
 # frictionless; Baumgarte forces do O(violation * lambda) ~ 1e-6 m * 1e5 N = 0.1 J of work).
 # Error budget: RK45 at rtol 1e-6 keeps the state's relative error ~1e-6 per step, i.e. an
 # energy error ~1e-6 of the energy exchanged per step, accumulated over <= ~100 steps: 1e-4;
-# the trapezoidal cylinder work on the output grid has error (dt)^2/12 * |d2P/dt2|.  Tolerance:
-# 1e-3 of the energy scale (range of the mechanical energy over the run, plus |work|), ten
-# times the budget.
+# the cylinder work is integrated as an extra state of the same run (sim_core.energy_audit;
+# a trapezoidal sum on the 25 ms output grid was off by ~250 J during the 0.1 s drive ramps).
+# Tolerance: 1e-3 of the energy scale (range of the mechanical energy over the run, plus
+# |work|), ten times the budget.
 ENERGY_REL_TOL = 1e-3
 # Absolute part: the energy is evaluated from states that RK45 carries with a position error
 # ~ rtol * |q| + atol ~ 1e-6 * 10 m = 1e-5 m, so the gravity potential alone is uncertain by
