@@ -174,7 +174,7 @@ def build_config(payload, angle_deg, L_grid=L_GRID, stroke_ref=STROKE_REF, n_nod
         res[i] = linearize_at(p, L_grid[i], rope_L0, z_guess=guess)
         log(f"  m_p={payload:g} kg theta={angle_deg:g} deg L_s={L_grid[i]:.3f} m: in-plane f = "
             + ", ".join(f"{w / 2 / np.pi:.3f}" for w in res[i]["omega"])
-            + f" Hz, zeta = " + ", ".join(f"{x:.4f}" for x in res[i]["zeta"])
+            + " Hz, zeta = " + ", ".join(f"{x:.4f}" for x in res[i]["zeta"])
             + ", ropes " + ", ".join(f"{k} {v / 1e3:.1f} kN" for k, v in res[i]["tensions"].items())
             + f" ({time.perf_counter() - t0:.1f} s)")
     # sign alignment along the grid (reference: positive Gamma at the first point)
