@@ -28,11 +28,11 @@ A controller that never stops gets ``null`` times and residuals over the last 4 
 from __future__ import annotations
 
 import argparse
+import io
 import json
 import math
 import os
 import sys
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
@@ -262,27 +262,16 @@ def plot(traces: dict, path: str | os.PathLike) -> None:
 
 
 def _atomic_savefig(fig, path) -> None:
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=path.suffix)
-    os.close(fd)
-    try:
-        fig.savefig(tmp, dpi=110)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    """fig rendered in memory, written with sim_core's atomic writer (format from the suffix)."""
+    from sim_core.result import atomic_write_bytes
+    buf = io.BytesIO()
+    fig.savefig(buf, format=Path(path).suffix.lstrip(".") or "png", dpi=110)
+    atomic_write_bytes(path, buf.getvalue())
 
 
 def atomic_write_text(path, text: str) -> None:
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=path.suffix)
-    with os.fdopen(fd, "w") as f:
-        f.write(text)
-    os.chmod(tmp, 0o644)
-    os.replace(tmp, path)
+    from sim_core.result import atomic_write_bytes
+    atomic_write_bytes(path, text.encode())
 
 
 def main(argv=None) -> int:

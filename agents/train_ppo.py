@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import io
 import os
 import sys
 import time
@@ -110,12 +111,12 @@ def _curve_callback(path: Path, every: int):
             self._write()
 
         def _write(self) -> None:
-            tmp = path.with_suffix(".tmp")
-            with open(tmp, "w", newline="") as f:
-                w = csv.writer(f)
-                w.writerow(["env_steps", "episodes", "mean_return_last20", "success_rate_last20"])
-                w.writerows(self.rows)
-            os.replace(tmp, path)
+            from .evaluate import atomic_write_text
+            buf = io.StringIO(newline="")
+            w = csv.writer(buf)
+            w.writerow(["env_steps", "episodes", "mean_return_last20", "success_rate_last20"])
+            w.writerows(self.rows)
+            atomic_write_text(path, buf.getvalue())
 
     return LearningCurve()
 

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import argparse
 import csv
-import os
+import io
 import time
 from pathlib import Path
 
@@ -24,6 +24,7 @@ import numpy as np
 
 from sim_core.folding import FoldingParams, simulate_folding
 from sim_core.folding_plots import plot_folding
+from sim_core.result import atomic_write_bytes
 
 OUT = Path(__file__).parent / "results" / "folding_filter_h"
 
@@ -75,15 +76,14 @@ def main(argv=None) -> int:
     ax.grid(alpha=0.3)
     ax.legend()
     fig.tight_layout()
-    tmp = OUT / "tip_velocity_spectrum.tmp.png"
-    fig.savefig(tmp, dpi=110)
-    os.replace(tmp, OUT / "tip_velocity_spectrum.png")
-    tmp = OUT / "summary.tmp.csv"
-    with open(tmp, "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(["h_s", "n_rhs", "n_steps", "wall_s", "energy_above_20Hz"])
-        w.writerows(rows)
-    os.replace(tmp, OUT / "summary.csv")
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110)
+    atomic_write_bytes(OUT / "tip_velocity_spectrum.png", buf.getvalue())
+    text = io.StringIO(newline="")
+    w = csv.writer(text)
+    w.writerow(["h_s", "n_rhs", "n_steps", "wall_s", "energy_above_20Hz"])
+    w.writerows(rows)
+    atomic_write_bytes(OUT / "summary.csv", text.getvalue().encode())
     return 0
 
 

@@ -67,6 +67,7 @@ def integrate_rk45(model, y0: np.ndarray, t_end: float, sol: dict, progress=None
     t_eval = np.linspace(0.0, t_end, sol["n_output"])
     rhs = _CountingRHS(model)
     kwargs = {"max_step": sol["max_step"]} if "max_step" in sol else {}
+    budget = sol.get("max_wall_s")
     wall0 = time.perf_counter()
     solver = RK45(rhs, 0.0, y0, t_end, rtol=sol["rtol"], atol=sol["atol"], **kwargs)
     ys = [y0]
@@ -97,7 +98,6 @@ def integrate_rk45(model, y0: np.ndarray, t_end: float, sol: dict, progress=None
                     k_out += 1
             if progress is not None:
                 progress(solver.t, time.perf_counter() - wall0)
-            budget = sol.get("max_wall_s")
             if budget is not None and solver.status == "running" \
                     and time.perf_counter() - wall0 > budget:
                 raise SimulationError(solver.t, f"wall-clock budget solver.max_wall_s = {budget:g} s "

@@ -308,11 +308,12 @@ def initial_equilibrium(ts: TelescopicSystem, t: float = 0.0):
     ext.bilateral = True
     try:
         z, lam = constrained_static_equilibrium(m, z0, t)
-        T = ext.tension(length(ext, z))
+        ell_e = length(ext, z)
+        T = ext.tension(ell_e)
     finally:
         ext.bilateral = False
     s = ext.slack_width
-    ell_e, ell_r = length(ext, z), length(retr, z)
+    ell_r = length(retr, z)
     if T >= k_e * s:
         # the extraction rope carries T in its stiff branch: same forces, nothing to re-solve
         ext.L0 = taut_L0(ext, ell_e, T)
