@@ -53,13 +53,15 @@ above the kept ones (static correction not added), off-diagonal modal damping, a
 from __future__ import annotations
 
 import argparse
-import os
+import io
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 import scipy.linalg as sla
+
+from .result import atomic_write_bytes
 
 DATA = Path(__file__).parent / "data" / "modal_telescopic.npz"
 N_MODES_TABLE = 4
@@ -243,11 +245,9 @@ def build_tables(path=DATA, payloads=PAYLOADS, angles=ANGLES, L_grid=L_GRID, log
               for k, v in data.items()}
     meta = dict(L_grid=np.asarray(L_grid), payloads=np.asarray(payloads), angles=np.asarray(angles),
                 n_nodes=N_NODES, stroke_ref=STROKE_REF, build_s=time.perf_counter() - t0)
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.stem + ".tmp.npz")
-    np.savez_compressed(tmp, **arrays, **meta)
-    os.replace(tmp, path)
+    buf = io.BytesIO()
+    np.savez_compressed(buf, **arrays, **meta)
+    atomic_write_bytes(path, buf.getvalue())
     log(f"wrote {path} ({time.perf_counter() - t0:.0f} s)")
 
 
