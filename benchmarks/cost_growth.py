@@ -36,7 +36,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..")))
 
-from sim_core.simulate import integrate_rk45                                       # noqa: E402
+from sim_core.simulate import integrate                                       # noqa: E402
 from sim_core.telescopic import TelescopicParams, build_telescopic                 # noqa: E402
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
@@ -62,7 +62,7 @@ def measure(n_booms: int, n_sub: int, sweep: str) -> dict:
            "rhs_ms": 1e3 * best, "t_sim": T}
     t0 = time.process_time()
     try:
-        _, _, st = integrate_rk45(m, y0, T, {"rtol": 1e-5, "atol": 1e-6, "n_output": 2})
+        _, _, st = integrate(m, y0, T, {"rtol": 1e-5, "atol": 1e-6, "n_output": 2})
         wall = time.process_time() - t0
         row.update(n_steps=st["n_steps"], n_rhs=st["n_rhs"], wall_s=wall, wall_per_sim_s=wall / T,
                    status="ok")

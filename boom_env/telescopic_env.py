@@ -14,7 +14,7 @@ Dynamics (``fidelity``)
 * ``"paper"``: the full sim_core model (``sim_core.telescopic``, frictionless by default,
   ``paper_n_nodes`` nodes per spline element, default 3) advanced step by step: for each control
   step the telescopic-cylinder constraint target is replaced by the env's stroke kinematics and
-  the model is integrated with ``sim_core.simulate.integrate_rk45`` (rtol 1e-6, atol 1e-7) from
+  the model is integrated with ``sim_core.simulate.integrate`` (rtol 1e-6, atol 1e-7) from
   the current state.  Slow: a real-time factor of order 0.1 or less; for checking policies, not
   for training.
 
@@ -369,9 +369,9 @@ class TelescopicBoomEnv(gym.Env):
         return (L + v * t, v, 0.0)
 
     def _paper_advance(self, segs):
-        from sim_core.simulate import integrate_rk45
+        from sim_core.simulate import integrate
         self._kin = (self.rom.L, self.rom.v, segs)
-        _, ys, _ = integrate_rk45(self._ts.model, self._y, self.dt,
+        _, ys, _ = integrate(self._ts.model, self._y, self.dt,
                                   {"rtol": 1e-6, "atol": 1e-7, "n_output": 2})
         self._y = ys[-1]
 

@@ -83,7 +83,7 @@ def _filter_power(m, filt, t, Q, Qd, Qdd) -> float:
 class AuditedSystem:
     """The telescopic model's first-order system extended by works (J) of WORK_NAMES:
     y = (z, z_dot, W_1, ..., W_k) for the chosen ``terms`` (default: all four).  Has ``rhs`` so
-    that sim_core.simulate.integrate_rk45 integrates it like a model.  ``terms=("drive_work",)``
+    that sim_core.simulate.integrate integrates it like a model.  ``terms=("drive_work",)``
     costs nothing beyond the model's own right-hand side (lambda is computed there anyway)."""
 
     def __init__(self, ts, terms=WORK_NAMES):
@@ -126,11 +126,11 @@ class AuditedSystem:
         return np.concatenate([y[n:2 * n], zdd, P])
 
     def integrate(self, y0: np.ndarray, t_end: float, sol: dict, progress=None):
-        """integrate_rk45 on the extended system from the model state y0 = (z, z_dot) with zero
+        """integrate on the extended system from the model state y0 = (z, z_dot) with zero
         works: returns (t, Y, stats), Y = (z, z_dot, works...)."""
-        from .simulate import integrate_rk45
+        from .simulate import integrate
         Y0 = np.concatenate([y0, np.zeros(len(self.terms))])
-        return integrate_rk45(self, Y0, t_end, sol, progress)
+        return integrate(self, Y0, t_end, sol, progress)
 
 
 def run_energy_audit(ts, y0: np.ndarray, t_end: float, rtol: float = 1e-6, atol: float = 1e-7,

@@ -542,14 +542,15 @@ def angular_momentum(fs: FoldingSystem, Q: np.ndarray, Qd: np.ndarray) -> np.nda
 
 
 def simulate_folding(p: FoldingParams, t_end: float = 45.0, n_output: int = 451,
-                     rtol: float = 1e-6, atol: float = 1e-8, progress=None, max_step=None,
-                     max_wall_s=None):
+                     rtol: float = 1e-6, atol: float = 1e-8, progress=None,
+                     solver: dict | None = None):
     """Run the folding scene from its static equilibrium; Result with tip_position,
     tip_velocity (boom-2 tip, m, m/s), cylinder_forces (N, pushing positive, one column per
     cylinder), cylinder_lengths (m), slew_angle (rad), boom_angles (boom-1 elevation and
     boom-2 relative angle from the rigid-body chain, rad) and constraint_violation (max |Phi|,
-    m or rad)."""
-    from .simulate import integrate_rk45, run_with_partial
+    m or rad).  ``solver``: a validated [solver] table (:func:`sim_core.scene.solver_table`);
+    its entries (method, max_step, max_wall_s, ...) take precedence over the keyword arguments."""
+    from .simulate import integrate, run_with_partial
     fs = build_folding(p)
     m = fs.model
     z0 = initial_equilibrium(fs)
@@ -559,12 +560,8 @@ def simulate_folding(p: FoldingParams, t_end: float = 45.0, n_output: int = 451,
         Qd[fs.i_phi] = p.initial_slew_rate
         Q, _ = m.full_state(0.0, z0, 0 * z0)
         y0[m.n_dof:] = m.reduced_state(0.0, Q, Qd)[1]
-    sol = {"rtol": rtol, "atol": atol, "n_output": n_output}
-    if max_step:
-        sol["max_step"] = max_step
-    if max_wall_s:
-        sol["max_wall_s"] = max_wall_s
-    return run_with_partial(lambda: integrate_rk45(m, y0, t_end, sol, progress),
+    sol = {"t_end": t_end, "rtol": rtol, "atol": atol, "n_output": n_output, **(solver or {})}
+    return run_with_partial(lambda: integrate(m, y0, sol["t_end"], sol, progress),
                             lambda t, ys, st, err: folding_result(fs, t, ys, st, err))
 
 

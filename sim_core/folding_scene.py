@@ -1,8 +1,8 @@
 """Scene schema of the folding long-boom manipulator (kind = "folding"), SI units.
 
   kind = "folding", name, description, notes
-  [solver]     t_end s (> 0), rtol (0, 1), atol (> 0), n_output (>= 2), method ("RK45"),
-               max_step s (> 0, optional)
+  [solver]     t_end s (> 0), rtol (0, 1), atol (> 0), n_output (>= 2), method ("RK45", "BDF",
+               "auto"), max_step s and max_wall_s s (> 0, optional)
   [booms]      length m (> 1), radius m (> 0), mass_per_length kg/m (> 0), E Pa (> 0),
                nu (-1, 0.5), n_nodes (3..33, nodes of the one spline element per boom; PD 9 =
                8 sub-elements), n_gauss (1..10; PD 3)
@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from .errors import SceneError
-from .scene import boolean, check_keys, choice, number
+from .scene import boolean, check_keys, number, solver_table
 
 _TOP = {"kind", "name", "description", "notes", "solver", "booms", "cylinders", "drive", "rest",
         "effects", "filtering", "gravity"}
@@ -37,19 +37,7 @@ def validate_folding(raw: dict, source: str) -> dict[str, Any]:
     check_keys(raw, _TOP, "scene")
     sc: dict[str, Any] = {"kind": "folding", "name": str(raw.get("name", "folding")),
                           "description": str(raw.get("description", "")), "source": source}
-    s = raw.get("solver", {})
-    check_keys(s, {"t_end", "rtol", "atol", "n_output", "method", "max_step", "max_wall_s"},
-               "solver")
-    sc["solver"] = {"t_end": number(s, "t_end", "solver", 45.0, lo=0.0, lo_open=True),
-                    "rtol": number(s, "rtol", "solver", 1e-6, lo=0.0, hi=1.0, lo_open=True,
-                                   hi_open=True),
-                    "atol": number(s, "atol", "solver", 1e-8, lo=0.0, lo_open=True),
-                    "n_output": number(s, "n_output", "solver", 451, lo=2, integer=True),
-                    "method": choice(s, "method", "solver", ("RK45",), "RK45")}
-    if "max_step" in s:
-        sc["solver"]["max_step"] = number(s, "max_step", "solver", lo=0.0, lo_open=True)
-    if "max_wall_s" in s:
-        sc["solver"]["max_wall_s"] = number(s, "max_wall_s", "solver", lo=0.0, lo_open=True)
+    sc["solver"] = solver_table(raw.get("solver", {}), t_end=45.0, n_output=451)
     b = raw.get("booms", {})
     check_keys(b, {"length", "radius", "mass_per_length", "E", "nu", "n_nodes", "n_gauss"}, "booms")
     sc["booms"] = {"length": number(b, "length", "booms", 12.0, lo=1.0, lo_open=True),

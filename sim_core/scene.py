@@ -9,7 +9,7 @@ an error names the dotted field, the value and the allowed range
 
 Beam-scene schema (units):
   name, description
-  [solver]   t_end s (> 0), method ("RK45"), rtol (0, 1), atol (> 0), n_output (>= 2),
+  [solver]   t_end s (> 0), method ("RK45", "BDF", "auto"), rtol (0, 1), atol (> 0), n_output (>= 2),
              max_step s (> 0, optional), max_wall_s s (> 0, optional: wall-clock budget; the
              run stops there with a SimulationError and a partial result)
   [effects]  gravity, torsion, filtering: booleans (what is off is not computed)
@@ -225,11 +225,33 @@ def choice(table: dict, key: str, where: str, allowed: tuple[str, ...], default=
     return v
 
 
+# -- the solver table (all scene kinds) ----------------------------------------------------------
+
+_SOLVER = {"t_end", "method", "rtol", "atol", "n_output", "max_step", "max_wall_s"}
+SOLVER_METHODS = ("RK45", "BDF", "auto")
+
+
+def solver_table(s: dict, t_end=None, atol: float = 1e-8, n_output: int = 201) -> dict:
+    """The validated [solver] table shared by every scene kind: t_end s (> 0), method
+    (``SOLVER_METHODS``, see :func:`sim_core.simulate.integrate`), rtol (0, 1), atol (> 0),
+    n_output (>= 2), optional max_step s (> 0) and max_wall_s s (> 0, wall-clock budget).
+    The arguments are the scene kind's defaults (t_end None: required)."""
+    check_keys(s, _SOLVER, "solver")
+    out = {"t_end": number(s, "t_end", "solver", t_end, lo=0.0, lo_open=True),
+           "method": choice(s, "method", "solver", SOLVER_METHODS, "RK45"),
+           "rtol": number(s, "rtol", "solver", 1e-6, lo=0.0, hi=1.0, lo_open=True, hi_open=True),
+           "atol": number(s, "atol", "solver", atol, lo=0.0, lo_open=True),
+           "n_output": number(s, "n_output", "solver", n_output, lo=2, integer=True)}
+    for key in ("max_step", "max_wall_s"):
+        if key in s:
+            out[key] = number(s, key, "solver", lo=0.0, lo_open=True)
+    return out
+
+
 # -- the scene ---------------------------------------------------------------------------------
 
 _TOP = {"name", "description", "solver", "effects", "filtering", "gravity", "beams",
         "boundary", "point_loads", "initial", "notes"}
-_SOLVER = {"t_end", "method", "rtol", "atol", "n_output", "max_step", "max_wall_s"}
 _EFFECTS = {"gravity", "torsion", "filtering"}
 _BEAM = {"name", "length", "breakpoints", "n_nodes", "n_gauss", "origin", "direction", "section"}
 _SECTION = {"E", "G", "rho", "A", "I_t", "I_b", "J", "I_p", "rotary_bending"}
@@ -247,19 +269,7 @@ def validate(raw: dict, source: str = "<scene>") -> dict:
             raise SceneError(f"scene.{key} = {raw[key]!r}: must be a string")
     sc: dict[str, Any] = {"name": raw.get("name", Path(source).stem),
                           "description": raw.get("description", ""), "source": source}
-    s = table_of(raw, "solver", "")
-    check_keys(s, _SOLVER, "solver")
-    solver = {
-        "t_end": number(s, "t_end", "solver", lo=0.0, lo_open=True),
-        "method": choice(s, "method", "solver", ("RK45",), "RK45"),
-        "rtol": number(s, "rtol", "solver", 1e-6, lo=0.0, hi=1.0, lo_open=True, hi_open=True),
-        "atol": number(s, "atol", "solver", 1e-8, lo=0.0, lo_open=True),
-        "n_output": number(s, "n_output", "solver", 201, lo=2, integer=True),
-    }
-    if "max_step" in s:
-        solver["max_step"] = number(s, "max_step", "solver", lo=0.0, lo_open=True)
-    if "max_wall_s" in s:
-        solver["max_wall_s"] = number(s, "max_wall_s", "solver", lo=0.0, lo_open=True)
+    solver = solver_table(table_of(raw, "solver", ""))
     sc["solver"] = solver
     t_end = solver["t_end"]
 

@@ -6,10 +6,11 @@ the stress filter of the second seed (Eq. 53) as an effect when the scene switch
 
 from __future__ import annotations
 
+import math
 import time
 
 import numpy as np
-from scipy.integrate import RK45
+from scipy.integrate import BDF, RK45
 
 from .assemble import build_model
 from .errors import SimulationError
@@ -58,29 +59,162 @@ class _CountingRHS:
         return np.full(len(y), self.BIG)
 
 
-def integrate_rk45(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
-    """Explicit RK45 (scipy's Dormand-Prince stepper) on model.rhs with dense output at
-    ``sol["n_output"]`` equally spaced times.  Returns (t, y, stats); raises SimulationError with
-    the time, step and last good state on failure or non-finite values, or when the optional
-    wall-clock budget ``sol["max_wall_s"]`` (s) is exhausted (the outputs reached so far are
-    attached, so a budgeted run still yields a partial result)."""
+METHODS = ("RK45", "BDF", "auto")
+
+
+class StiffnessDetector:
+    """Stiffness detection of Dormand-Prince (Hairer, Nørsett, Wanner, *Solving Ordinary
+    Differential Equations I*, 2nd ed., Sec. II.10, code DOPRI5): after every accepted step the
+    two stages evaluated at c = 1 give the local Lipschitz estimate
+
+        rho = ||k7 - k6|| / ||y_new - g6||,   g6 = y_old + h sum_j a_6j k_j,
+
+    and h rho approximates |h lambda| of the dominant eigenvalue.  RK45's stability boundary on
+    the negative real axis is about 3.3; when h rho > 3.25 on ``n_stiff`` accepted steps
+    without ``n_reset`` non-stiff steps in between, the step size is limited by stability, not
+    accuracy — the problem is stiff there."""
+
+    def __init__(self, n_stiff: int = 15, n_reset: int = 6, bound: float = 3.25):
+        self.n_stiff, self.n_reset, self.bound = n_stiff, n_reset, bound
+        self.stiff = 0
+        self.non_stiff = 0
+        self.last_h_rho = 0.0
+
+    def update(self, solver) -> bool:
+        """Call after an accepted step of a scipy RK45 solver; True once the problem is stiff."""
+        h = solver.t - solver.t_old
+        K = solver.K
+        g6 = solver.y_old + h * (K[:5].T @ solver.A[5, :5])
+        den = np.linalg.norm(solver.y - g6)
+        h_rho = h * np.linalg.norm(K[6] - K[5]) / den if den > 0.0 else 0.0
+        self.last_h_rho = float(h_rho)
+        if h_rho > self.bound:
+            self.non_stiff = 0
+            self.stiff += 1
+        else:
+            self.non_stiff += 1
+            if self.non_stiff >= self.n_reset:
+                self.stiff = 0
+        return self.stiff >= self.n_stiff
+
+
+class MethodSwitch:
+    """``solver.method = "auto"``: RK45 while it is cheaper, BDF while the problem is stiff.
+
+    RK45 -> BDF when :class:`StiffnessDetector` reports a stability-limited step; RK45's cost
+    over its last ``window`` accepted steps is recorded.  BDF runs ``bdf_steps`` accepted steps,
+    then hands back to RK45 (a trial: if the problem is still stiff the detector switches again
+    after its 15 steps).  Each BDF stretch is judged against the RK45 stretch before it (cost =
+    model evaluations per simulated second, BDF's finite-difference Jacobians included): when
+    BDF was cheaper, its next stretch is twice as long (up to ``max_bdf_steps``); when it was
+    dearer (e.g. sticking friction that changes regime every few steps, so BDF recomputes its
+    Jacobian of 2 n_dof evaluations almost every step), its next stretch is halved and RK45
+    ignores the detector for a cool-down that doubles with every such loss.  Costs are counted
+    in model evaluations, not wall time, so a run is reproducible.  ``switches`` lists (t s,
+    method switched to)."""
+
+    def __init__(self, rhs: "_CountingRHS", window: int = 30, bdf_steps: int = 40,
+                 max_bdf_steps: int = 5000):
+        self.rhs = rhs
+        self.window = window
+        self.bdf_steps, self.min_bdf_steps, self.max_bdf_steps = bdf_steps, bdf_steps, max_bdf_steps
+        self.detector = StiffnessDetector()
+        self.recent: list[tuple[float, int]] = []      # (t, evaluations) after accepted steps
+        self.start: tuple[float, int] = (0.0, 0)       # at the start of the current stretch
+        self.rk45_cost = math.inf
+        self.cool_down = 0
+        self.last_loss_cool_down = 0
+        self.n_bdf = 0
+        self.switches: list[tuple[float, str]] = []
+
+    @staticmethod
+    def _cost(a: tuple[float, int], b: tuple[float, int]) -> float:
+        return (b[1] - a[1]) / (b[0] - a[0]) if b[0] > a[0] else math.inf
+
+    def after_step(self, solver, make):
+        """Call after every accepted step; returns the solver to continue with (``make(cls,
+        t, y)`` builds a new one)."""
+        now = (float(solver.t), self.rhs.nfev)
+        if isinstance(solver, RK45):
+            self.recent = (self.recent + [now])[-self.window - 1:]
+            if self.cool_down > 0:
+                self.cool_down -= 1
+                return solver
+            if not self.detector.update(solver):
+                return solver
+            self.rk45_cost = self._cost(self.recent[0], now)
+            self.n_bdf = 0
+            new, name = make(BDF, solver.t, solver.y), "BDF"
+        else:
+            self.n_bdf += 1
+            if self.n_bdf < self.bdf_steps:
+                return solver
+            if self._cost(self.start, now) < self.rk45_cost:          # BDF paid off
+                self.bdf_steps = min(2 * self.bdf_steps, self.max_bdf_steps)
+                self.last_loss_cool_down = 0
+            else:                                                      # RK45 was cheaper
+                self.bdf_steps = max(self.bdf_steps // 2, self.min_bdf_steps)
+                self.last_loss_cool_down = min(max(2 * self.last_loss_cool_down, 100), 10000)
+                self.cool_down = self.last_loss_cool_down
+            self.detector = StiffnessDetector()
+            self.recent = [now]
+            new, name = make(RK45, solver.t, solver.y), "RK45"
+        self.start = now
+        self.switches.append((float(solver.t), name))
+        return new
+
+
+def integrate(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
+    """Integrate model.rhs from t = 0 with dense output at ``sol["n_output"]`` equally spaced
+    times.  ``sol["method"]``:
+
+    * ``"RK45"`` (default): scipy's explicit Dormand-Prince pair — cheapest per step while the
+      step size is set by accuracy;
+    * ``"BDF"``: scipy's variable-order BDF with finite-difference Jacobians (one model.rhs per
+      state per Jacobian) — for stiff runs (sticking friction, stiff contact);
+    * ``"auto"``: RK45 and BDF alternate as :class:`MethodSwitch` decides (RK45 -> BDF when
+      :class:`StiffnessDetector` finds the step stability-limited, back to RK45 after a
+      stretch whose length adapts to which method was cheaper); the statistics record the
+      number of switches and the first switch to BDF.
+
+    Returns (t, y, stats); raises SimulationError with the time, step and last good state on
+    failure or non-finite values, or when the optional wall-clock budget ``sol["max_wall_s"]``
+    (s) is exhausted (the outputs reached so far are attached, so a budgeted run still yields a
+    partial result)."""
+    method = sol.get("method", "RK45")
+    if method not in METHODS:
+        raise ValueError(f"solver.method = {method!r}: must be one of {METHODS}")
     t_eval = np.linspace(0.0, t_end, sol["n_output"])
     rhs = _CountingRHS(model)
     kwargs = {"max_step": sol["max_step"]} if "max_step" in sol else {}
     budget = sol.get("max_wall_s")
     wall0 = time.perf_counter()
-    solver = RK45(rhs, 0.0, y0, t_end, rtol=sol["rtol"], atol=sol["atol"], **kwargs)
+    tol = {"rtol": sol["rtol"], "atol": sol["atol"]}
+
+    def make(cls, t0, y):
+        return cls(rhs, t0, y, t_end, **tol, **kwargs)
+
+    solver = make(BDF if method == "BDF" else RK45, 0.0, y0)
+    switch = MethodSwitch(rhs) if method == "auto" else None
+    njev = 0                  # Jacobians of BDF solvers already replaced by a switch
     ys = [y0]
     k_out = 1
     steps = []
 
     def stats():
         wall = time.perf_counter() - wall0
-        return {"wall_time_s": wall, "n_steps": len(steps), "n_rhs": int(rhs.nfev),
-                "n_failed_rhs": int(rhs.n_failed),
-                "min_step_s": float(min(steps)) if steps else 0.0,
-                "max_step_s": float(max(steps)) if steps else 0.0,
-                "method": "RK45", "real_time_factor": t_end / max(wall, 1e-12)}
+        out = {"wall_time_s": wall, "n_steps": len(steps), "n_rhs": int(rhs.nfev),
+               "n_failed_rhs": int(rhs.n_failed),
+               "min_step_s": float(min(steps)) if steps else 0.0,
+               "max_step_s": float(max(steps)) if steps else 0.0,
+               "method": method, "real_time_factor": t_end / max(wall, 1e-12)}
+        if method != "RK45":
+            out["n_jacobians"] = njev + int(getattr(solver, "njev", 0))
+        if switch is not None:
+            out["n_method_switches"] = len(switch.switches)
+            out["first_switch_to_bdf_s"] = switch.switches[0][0] if switch.switches else -1.0
+            out["last_switch_s"] = switch.switches[-1][0] if switch.switches else -1.0
+        return out
 
     try:
         while solver.status == "running":
@@ -88,7 +222,8 @@ def integrate_rk45(model, y0: np.ndarray, t_end: float, sol: dict, progress=None
             if solver.status == "failed" or not np.all(np.isfinite(solver.y)):
                 why = (f" after {rhs.failures} failed stage evaluations ({rhs.last_reason})"
                        if rhs.failures else "")
-                raise SimulationError(solver.t, f"RK45 failed: {msg}{why}", step=solver.step_size,
+                name = "BDF" if isinstance(solver, BDF) else "RK45"
+                raise SimulationError(solver.t, f"{name} failed: {msg}{why}", step=solver.step_size,
                                       last_state=solver.y)
             steps.append(solver.t - solver.t_old)
             if k_out < len(t_eval) and t_eval[k_out] <= solver.t:
@@ -103,6 +238,11 @@ def integrate_rk45(model, y0: np.ndarray, t_end: float, sol: dict, progress=None
                 raise SimulationError(solver.t, f"wall-clock budget solver.max_wall_s = {budget:g} s "
                                       f"exhausted (last step {solver.step_size:.3g} s)",
                                       step=solver.step_size, last_state=solver.y)
+            if switch is not None and solver.status == "running":
+                old = solver
+                solver = switch.after_step(solver, make)
+                if solver is not old:
+                    njev += int(getattr(old, "njev", 0))
     except SimulationError as exc:
         # keep what was computed: the caller turns it into a partial Result (exc.result)
         exc.partial = (t_eval[:len(ys)], np.array(ys), stats())
@@ -141,17 +281,14 @@ def simulate(scene: dict, progress=None) -> Result:
                                  sol["t_end"], sol["n_output"])
             res.scene = scene
             return res
-        res = simulate_telescopic(params_from_scene(scene), sol["t_end"], sol["n_output"],
-                                  sol["rtol"], sol["atol"], progress, sol.get("max_wall_s"))
+        res = simulate_telescopic(params_from_scene(scene), progress=progress, solver=sol)
         res.scene = scene
         return res
     if scene.get("kind") == "folding":
         from .folding import simulate_folding
         from .folding_scene import params_from_scene as folding_params
         sol = scene["solver"]
-        res = simulate_folding(folding_params(scene), sol["t_end"], sol["n_output"],
-                               sol["rtol"], sol["atol"], progress, sol.get("max_step"),
-                               sol.get("max_wall_s"))
+        res = simulate_folding(folding_params(scene), progress=progress, solver=sol)
         res.scene = scene
         return res
     model, Q0, Qd0 = build_model(scene)
@@ -160,7 +297,7 @@ def simulate(scene: dict, progress=None) -> Result:
     if scene["initial"]["static_equilibrium"]:
         z0 = static_equilibrium(model, z0)
     y0 = np.concatenate([z0, zd0])
-    return run_with_partial(lambda: integrate_rk45(model, y0, sol["t_end"], sol, progress),
+    return run_with_partial(lambda: integrate(model, y0, sol["t_end"], sol, progress),
                             lambda ts, ys, stats, err: _beam_result(model, scene, ts, ys, stats, err))
 
 

@@ -328,23 +328,25 @@ def initial_equilibrium(ts: TelescopicSystem, t: float = 0.0):
 
 def simulate_telescopic(p: TelescopicParams, t_end: float = 20.0, n_output: int = 201,
                         rtol: float = 1e-6, atol: float = 1e-7, progress=None,
-                        max_wall_s: float | None = None):
+                        solver: dict | None = None):
     """Run the telescopic scene from its static equilibrium and return a Result with the
     public outputs of the telescopic contract (tip kinematics, piston stroke, cylinder forces,
     contact-point resultants, contact coordinates, constraint violation; with friction also the
     normal force of every slider spring per region (I_12, II_12, I_23, II_23; springs ordered arc
-    by arc P1, P2, P3 as in sim_core.contact) and the signed friction coefficient per region)."""
-    from .simulate import integrate_rk45, run_with_partial
+    by arc P1, P2, P3 as in sim_core.contact) and the signed friction coefficient per region).
+    ``solver``: a validated [solver] table (:func:`sim_core.scene.solver_table`); its entries
+    (method, max_step, max_wall_s, ...) take precedence over the keyword arguments."""
+    from .simulate import integrate, run_with_partial
+    sol = {"t_end": t_end, "rtol": rtol, "atol": atol, "n_output": n_output, **(solver or {})}
     if not p.flexible:
         from .rigid_telescopic import RigidTelescopic
-        return RigidTelescopic(p).simulate(t_end, n_output, rtol, atol)
+        return RigidTelescopic(p).simulate(sol["t_end"], sol["n_output"], sol["rtol"], sol["atol"])
     ts = build_telescopic(p)
     m = ts.model
     z0, _ = initial_equilibrium(ts)
     y0 = np.concatenate([z0, 0 * z0])
     return run_with_partial(
-        lambda: integrate_rk45(m, y0, t_end, {"rtol": rtol, "atol": atol, "n_output": n_output,
-                                              "max_wall_s": max_wall_s}, progress),
+        lambda: integrate(m, y0, sol["t_end"], sol, progress),
         lambda t, ys, stats, err: _telescopic_result(ts, t, ys, stats, err))
 
 

@@ -1,8 +1,9 @@
 """Scene schema of the telescopic boom system (kind = "telescopic"), SI units.
 
   kind = "telescopic", name, description
-  [solver]     t_end s (> 0), rtol (0, 1), atol (> 0), n_output (>= 2), method ("RK45"),
-               max_wall_s s (> 0, optional wall-clock budget: stops with a partial result)
+  [solver]     t_end s (> 0), rtol (0, 1), atol (> 0), n_output (>= 2), method ("RK45", "BDF",
+               "auto"), max_step s and max_wall_s s (> 0, optional; max_wall_s: wall-clock budget,
+               stops with a partial result)
   [booms]      count (2..5; ropes only for 3), length m (> 0), luffing_angle_deg (0..85),
                stroke0 m (piston-rod length L_s at t = 0, > 0), L_h m (luffing point on boom 1,
                within (0, length)), E Pa (> 0), rho kg/m^3 (> 0), n_nodes (3..33 per spline
@@ -46,7 +47,7 @@ from __future__ import annotations
 from typing import Any
 
 from .errors import SceneError
-from .scene import boolean, check_keys, choice, number
+from .scene import boolean, check_keys, choice, number, solver_table
 
 _TOP = {"kind", "name", "description", "solver", "booms", "drive", "payload", "ropes", "effects",
         "filtering", "gravity", "contact", "notes", "model"}
@@ -56,15 +57,7 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
     check_keys(raw, _TOP, "scene")
     sc: dict[str, Any] = {"kind": "telescopic", "name": str(raw.get("name", "telescopic")),
                           "description": str(raw.get("description", "")), "source": source}
-    s = raw.get("solver", {})
-    check_keys(s, {"t_end", "rtol", "atol", "n_output", "method", "max_wall_s"}, "solver")
-    sc["solver"] = {"t_end": number(s, "t_end", "solver", 20.0, lo=0.0, lo_open=True),
-                    "rtol": number(s, "rtol", "solver", 1e-6, lo=0.0, hi=1.0, lo_open=True, hi_open=True),
-                    "atol": number(s, "atol", "solver", 1e-7, lo=0.0, lo_open=True),
-                    "n_output": number(s, "n_output", "solver", 201, lo=2, integer=True),
-                    "method": choice(s, "method", "solver", ("RK45",), "RK45")}
-    if "max_wall_s" in s:
-        sc["solver"]["max_wall_s"] = number(s, "max_wall_s", "solver", lo=0.0, lo_open=True)
+    sc["solver"] = solver_table(raw.get("solver", {}), t_end=20.0, atol=1e-7)
     b = raw.get("booms", {})
     check_keys(b, {"count", "length", "luffing_angle_deg", "stroke0", "L_h", "E", "rho",
                    "n_nodes", "n_gauss"}, "booms")

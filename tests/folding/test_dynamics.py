@@ -11,7 +11,7 @@ import pytest
 from sim_core.folding import (PLANE_BASIS, SLEW_AXIS, FoldingParams, angular_momentum,
                               build_folding, folding_result, simulate_folding)
 from sim_core.rigid_body import rot_axis
-from sim_core.simulate import integrate_rk45
+from sim_core.simulate import integrate
 
 # ---------------------------------------------------------------------------------------------
 # rigid-limit kinematics: booms E x 1000, cylinders as exact (massless, rigid) length drivers
@@ -144,7 +144,7 @@ def _free_slew_run(rtol, n_nodes=3):
     C = constraint_terms(m.nonlinear, 0.0, Q, Qd)[1] @ m.P
     Minv_Ct = np.linalg.solve(Mr, C.T)
     zd0 = zd_g - Minv_Ct @ np.linalg.solve(C @ Minv_Ct, C @ zd_g)
-    t, ys, st = integrate_rk45(m, np.concatenate([z0, zd0]), 0.5,
+    t, ys, st = integrate(m, np.concatenate([z0, zd0]), 0.5,
                                {"rtol": rtol, "atol": rtol * 1e-2, "n_output": 6})
     res = folding_result(fs, t, ys, st, None)
     return res

@@ -8,7 +8,7 @@ from sim_core.scene import load_scene
 CASES = [
     ({"solver.t_end": 0}, "solver.t_end = 0: out of range, allowed (0, inf)"),
     ({"solver.rtol": 1.5}, "solver.rtol = 1.5: out of range, allowed (0, 1)"),
-    ({"solver.method": "BDF"}, "solver.method"),
+    ({"solver.method": "Radau"}, "solver.method"),
     ({"solver.n_output": 1}, "solver.n_output = 1: out of range, allowed [2, inf)"),
     ({"booms.length": 0.5}, "booms.length = 0.5: out of range, allowed (1, inf)"),
     ({"booms.E": -1.0}, "booms.E = -1.0: out of range, allowed (0, inf)"),

@@ -9,7 +9,7 @@ import pytest
 
 from sim_core.integrators import integrate_generalized_alpha
 from sim_core.integrators.index1 import Index1System
-from sim_core.simulate import integrate_rk45
+from sim_core.simulate import integrate
 from sim_core.telescopic import TelescopicParams, build_telescopic, initial_equilibrium
 
 
@@ -41,7 +41,7 @@ def test_generalized_alpha_on_index1_wrapper_matches_rk45_rigid_case():
     t_end = 0.05
     rtol_ga, atol_ga = 1e-5, 1e-6
     rtol_rk, atol_rk = 1e-7, 1e-8
-    _, ys, _ = integrate_rk45(m, np.concatenate([z0, 0 * z0]), t_end,
+    _, ys, _ = integrate(m, np.concatenate([z0, 0 * z0]), t_end,
                               {"rtol": rtol_rk, "atol": atol_rk, "n_output": 2})
     res = integrate_generalized_alpha(Index1System(m), (0.0, t_end), z0, 0 * z0, rtol=rtol_ga,
                                       atol=atol_ga, t_eval=[t_end])

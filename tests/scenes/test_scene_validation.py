@@ -226,6 +226,19 @@ def test_unknown_method_suggests():
                  "did you mean 'RK45'")
 
 
+@pytest.mark.parametrize("scene", ["beam_through_sleeve", "telescopic_extraction", "folding_boom"])
+def test_one_solver_table_for_every_scene_kind(scene):
+    """The [solver] table is validated by one function (sim_core.scene.solver_table) for all
+    scene kinds: the same methods are accepted, the same errors name the field and range."""
+    for method in ("RK45", "BDF", "auto"):
+        assert load_scene(scene, overrides={"solver.method": method})["solver"]["method"] == method
+    assert_names(err({"solver.method": "Radau"}, scene), "solver.method", "'Radau'",
+                 "RK45", "BDF", "auto")
+    assert_names(err({"solver.max_step": 0}, scene), "solver.max_step", "(0, inf)")
+    assert_names(err({"solver.max_wall_s": -1}, scene), "solver.max_wall_s", "(0, inf)")
+    assert_names(err({"solver.rtol": 1.0}, scene), "solver.rtol", "(0, 1)")
+
+
 @pytest.mark.parametrize("key, field", [("effects.gravity", "effects.gravity"),
                                         ("initial.static_equilibrium", "initial.static_equilibrium")])
 def test_boolean_field(key, field):

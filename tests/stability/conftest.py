@@ -6,7 +6,7 @@ numerically stable").
   statics (friction, slider springs, gap, smoothing interval and the stress filter do not act at
   rest: friction law mu(0) = 0, the filter forces are rate terms).
 * ``run_window`` integrates the full model with sim_core's own RK45 driver
-  (``sim_core.simulate.integrate_rk45``: the integrator statistics, including the minimum
+  (``sim_core.simulate.integrate``: the integrator statistics, including the minimum
   accepted step ``min_step_s``) and returns the public Result plus the total mechanical energy
   and the telescopic-cylinder work at the output times.
 """
@@ -18,7 +18,7 @@ import pytest
 
 from sim_core.energy_audit import AuditedSystem
 from sim_core.energy_audit import mechanical_energy as _mechanical_energy
-from sim_core.simulate import integrate_rk45, run_with_partial
+from sim_core.simulate import integrate, run_with_partial
 from sim_core.telescopic import (TelescopicParams, _telescopic_result, build_telescopic,
                                  initial_equilibrium)
 
@@ -116,7 +116,7 @@ def run_window(ts, y0, t_end: float, n_output: int = 21, rtol: float = 1e-6, ato
 
     if energy:
         return run_with_partial(lambda: audited.integrate(y0, t_end, sol, watch), collect)
-    return run_with_partial(lambda: integrate_rk45(m, y0, t_end, sol, watch), collect)
+    return run_with_partial(lambda: integrate(m, y0, t_end, sol, watch), collect)
 
 
 def energy_tol(ts, res) -> float:

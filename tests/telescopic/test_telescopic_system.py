@@ -7,7 +7,7 @@ checked quantities are resultants and rigid-limit kinematics that do not need th
 import numpy as np
 import pytest
 
-from sim_core.simulate import integrate_rk45
+from sim_core.simulate import integrate
 from sim_core.telescopic import TelescopicParams, build_telescopic, initial_equilibrium
 from sim_core.validation.closed_form import rigid_tip_kinematics, static_luffing_forces
 
@@ -68,7 +68,7 @@ def test_rigid_limit_extraction_follows_paper_kinematics(rigid_equilibrium):
     m = ts.model
     y0 = np.concatenate([z, 0 * z])
     t_end = 0.5
-    t, ys, stats = integrate_rk45(m, y0, t_end, {"rtol": 1e-6, "atol": 1e-7, "n_output": 3})
+    t, ys, stats = integrate(m, y0, t_end, {"rtol": 1e-6, "atol": 1e-7, "n_output": 3})
     Q_start, _ = m.full_state(0.0, z, 0 * z)
     r0 = ts.tip(Q_start)[0]
     ref = rigid_tip_kinematics(t, ts.schedule, np.radians(60.0), (r0[0], r0[2]))
@@ -104,7 +104,7 @@ def test_rigid_limit_error_shrinks_as_E_grows():
         ts = build_telescopic(TelescopicParams(n_nodes=3, E=E, payload=1000.0))
         z, _ = initial_equilibrium(ts)
         m = ts.model
-        t, ys, _ = integrate_rk45(m, np.concatenate([z, 0 * z]), 0.5,
+        t, ys, _ = integrate(m, np.concatenate([z, 0 * z]), 0.5,
                                   {"rtol": 1e-8, "atol": 1e-10, "n_output": 11})
         r0 = ts.tip(m.full_state(0.0, z, 0 * z)[0])[0]
         ref = rigid_tip_kinematics(t, ts.schedule, np.radians(60.0), (r0[0], r0[2]))
