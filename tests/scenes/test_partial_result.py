@@ -91,3 +91,27 @@ def test_wall_clock_budget_is_validated():
     for name in ("beam_through_sleeve", "telescopic_extraction", "folding_boom"):
         with pytest.raises(SceneError, match="max_wall_s"):
             load_scene(name, overrides={"solver.max_wall_s": -1.0})
+
+
+def test_ctrl_c_stops_with_a_partial_result(monkeypatch):
+    """Ctrl-C (KeyboardInterrupt inside a right-hand side) ends the run like a budget: a typed
+    SimulationError saying so, at the time reached, with the outputs computed so far."""
+    original = Model.rhs
+
+    def interrupted_rhs(self, t, y):
+        if t > 0.004:
+            raise KeyboardInterrupt
+        return original(self, t, y)
+
+    monkeypatch.setattr(Model, "rhs", interrupted_rhs)
+    sc = load_scene("beam_through_sleeve", overrides={
+        "solver.t_end": 0.01, "solver.n_output": 11, "effects.filtering": False,
+        "beams.0.n_nodes": 5, "initial.static_equilibrium": False})
+    with pytest.raises(SimulationError) as info:
+        simulate(sc)
+    exc = info.value
+    assert "KeyboardInterrupt" in exc.reason and exc.t <= 0.004 + 1e-12
+    res = exc.result
+    assert res.error and "interrupted" in res.error
+    assert 1 <= len(res.t) < 11 and res.t[-1] <= 0.004 + 1e-12
+    assert np.all(np.isfinite(res["tip_position"]))
