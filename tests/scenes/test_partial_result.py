@@ -7,6 +7,13 @@ from sim_core import SimulationError, load_scene, simulate
 from sim_core.model import Model
 
 
+def _short_sleeve_scene() -> dict:
+    """0.01 s of the sleeve scene, 11 outputs, 4 sub-elements, unfiltered, from rest."""
+    return load_scene("beam_through_sleeve", overrides={
+        "solver.t_end": 0.01, "solver.n_output": 11, "effects.filtering": False,
+        "beams.0.n_nodes": 5, "initial.static_equilibrium": False})
+
+
 def test_failure_attaches_partial_result(monkeypatch):
     original = Model.rhs
 
@@ -17,9 +24,7 @@ def test_failure_attaches_partial_result(monkeypatch):
         return out
 
     monkeypatch.setattr(Model, "rhs", failing_rhs)
-    sc = load_scene("beam_through_sleeve", overrides={
-        "solver.t_end": 0.01, "solver.n_output": 11, "effects.filtering": False,
-        "beams.0.n_nodes": 5, "initial.static_equilibrium": False})
+    sc = _short_sleeve_scene()
     with pytest.raises(SimulationError) as info:
         simulate(sc)
     exc = info.value
@@ -45,9 +50,7 @@ def test_failed_stage_evaluation_is_retried_with_a_smaller_step(monkeypatch):
         return out
 
     monkeypatch.setattr(Model, "rhs", flaky_rhs)
-    sc = load_scene("beam_through_sleeve", overrides={
-        "solver.t_end": 0.01, "solver.n_output": 11, "effects.filtering": False,
-        "beams.0.n_nodes": 5, "initial.static_equilibrium": False})
+    sc = _short_sleeve_scene()
     res = simulate(sc)
     assert res.error is None and len(res.t) == 11
     # 3 injected failures; the later stages of a failed step start from its huge derivatives and
@@ -104,9 +107,7 @@ def test_ctrl_c_stops_with_a_partial_result(monkeypatch):
         return original(self, t, y)
 
     monkeypatch.setattr(Model, "rhs", interrupted_rhs)
-    sc = load_scene("beam_through_sleeve", overrides={
-        "solver.t_end": 0.01, "solver.n_output": 11, "effects.filtering": False,
-        "beams.0.n_nodes": 5, "initial.static_equilibrium": False})
+    sc = _short_sleeve_scene()
     with pytest.raises(SimulationError) as info:
         simulate(sc)
     exc = info.value
