@@ -6,8 +6,8 @@ One command (repository root):
     OPENBLAS_NUM_THREADS=1 PYTHONPATH=. python benchmarks/work_precision.py           # full
 
 Quick mode: one telescopic mesh (2 sub-elements) and none of the rows that cannot finish in
-its budget (those are full-mode rows); it measured ~11 min before that trim on the shared
-2-core machine.  Full mode not run (estimate 3-6 h).  Each run has a process-time budget (row status "budget").
+its budget (those are full-mode rows): 3 min 44 s on the shared 2-core machine (2026-11-23;
+~11 min before that trim).  Full mode not run (estimate 3-6 h).  Each run has a process-time budget (row status "budget").
 
 Writes benchmarks/results/work_precision_beam.csv, work_precision_telescopic.csv and the
 log-log PNGs work_precision_beam.png, work_precision_telescopic.png (error vs wall seconds per
