@@ -28,7 +28,6 @@ A controller that never stops gets ``null`` times and residuals over the last 4 
 from __future__ import annotations
 
 import argparse
-import io
 import json
 import math
 import os
@@ -243,6 +242,8 @@ def plot(traces: dict, path: str | os.PathLike) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
+    from sim_core.plots import save_figure
     fig, ax = plt.subplots(3, 1, figsize=(7.5, 7.5), sharex=True)
     for name, tr in traces.items():
         ax[0].plot(tr.t, tr.stroke, label=name)
@@ -257,16 +258,8 @@ def plot(traces: dict, path: str | os.PathLike) -> None:
         a.grid(alpha=0.3)
     ax[0].set_title("Extraction 2 -> 8 m, 25 t, 60 deg (boom_env modal ROM)", fontsize=9)
     fig.tight_layout()
-    _atomic_savefig(fig, path)
+    save_figure(fig, path)
     plt.close(fig)
-
-
-def _atomic_savefig(fig, path) -> None:
-    """fig rendered in memory, written with sim_core's atomic writer (format from the suffix)."""
-    from sim_core.result import atomic_write_bytes
-    buf = io.BytesIO()
-    fig.savefig(buf, format=Path(path).suffix.lstrip(".") or "png", dpi=110)
-    atomic_write_bytes(path, buf.getvalue())
 
 
 def atomic_write_text(path, text: str) -> None:

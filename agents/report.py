@@ -19,7 +19,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .evaluate import _atomic_savefig, atomic_write_text
+from sim_core.plots import save_figure
+
+from .evaluate import atomic_write_text
 
 COLUMNS = (("time_to_target_s", "time to target (s)", "{:.2f}"),
            ("final_stroke_error_m", "final stroke error (mm)", "{:.2f}", 1e3),
@@ -90,7 +92,7 @@ def main(argv=None) -> int:
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    _atomic_savefig(fig, out / "learning_curve.png")
+    save_figure(fig, out / "learning_curve.png")
     plt.close(fig)
     md = ["# PPO baseline vs scripted schedules", ""]
     if args.eval:

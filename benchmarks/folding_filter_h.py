@@ -24,6 +24,7 @@ import numpy as np
 
 from sim_core.folding import FoldingParams, simulate_folding
 from sim_core.folding_plots import plot_folding
+from sim_core.plots import save_figure
 from sim_core.result import atomic_write_bytes
 
 OUT = Path(__file__).parent / "results" / "folding_filter_h"
@@ -76,9 +77,7 @@ def main(argv=None) -> int:
     ax.grid(alpha=0.3)
     ax.legend()
     fig.tight_layout()
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110)
-    atomic_write_bytes(OUT / "tip_velocity_spectrum.png", buf.getvalue())
+    save_figure(fig, OUT / "tip_velocity_spectrum.png")
     text = io.StringIO(newline="")
     w = csv.writer(text)
     w.writerow(["h_s", "n_rhs", "n_steps", "wall_s", "energy_above_20Hz"])

@@ -8,7 +8,7 @@ from typing import Mapping
 
 import numpy as np
 
-from .plots import _save
+from .plots import save_figure
 from .result import Result
 
 
@@ -34,7 +34,7 @@ def plot_folding(result: Result, out: str | Path,
     axes[-1].set_xlabel("t [s]")
     fig.suptitle(f"{result.scene.get('name', 'folding')}: boom-2 tip displacement")
     fig.tight_layout()
-    paths.append(_save(fig, out / "tip_displacement.png"))
+    paths.append(save_figure(fig, out / "tip_displacement.png"))
     plt.close(fig)
 
     if h_runs is None:
@@ -53,7 +53,7 @@ def plot_folding(result: Result, out: str | Path,
         ax.legend(fontsize=8)
     axes[-1].set_xlabel("t [s]")
     fig.tight_layout()
-    paths.append(_save(fig, out / "tip_velocity_h.png"))
+    paths.append(save_figure(fig, out / "tip_velocity_h.png"))
     plt.close(fig)
 
     if "cylinder_forces" in result:
@@ -69,6 +69,6 @@ def plot_folding(result: Result, out: str | Path,
         for ax in axes:
             ax.grid(alpha=0.3)
         fig.tight_layout()
-        paths.append(_save(fig, out / "folding_cylinders.png"))
+        paths.append(save_figure(fig, out / "folding_cylinders.png"))
         plt.close(fig)
     return paths

@@ -10,7 +10,8 @@ import numpy as np
 from .result import Result, atomic_write_bytes
 
 
-def _save(fig, path: Path) -> Path:
+def save_figure(fig, path: str | Path) -> Path:
+    """fig rendered as PNG in memory and written atomically (sim_core.result.atomic_write_bytes)."""
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=110)
     atomic_write_bytes(path, buf.getvalue())
@@ -40,7 +41,7 @@ def plot_result(result: Result, out: str | Path) -> list[Path]:
         axes[-1].set_xlabel("t [s]")
         fig.suptitle(result.scene.get("name", ""))
         fig.tight_layout()
-        paths.append(_save(fig, out / "tip.png"))
+        paths.append(save_figure(fig, out / "tip.png"))
         plt.close(fig)
     if "luffing_cylinder_force" in result:
         fig, axes = plt.subplots(2, 1, figsize=(8, 5), sharex=True)
@@ -53,7 +54,7 @@ def plot_result(result: Result, out: str | Path) -> list[Path]:
             ax.grid(alpha=0.3)
         fig.suptitle("cylinder forces (positive = pushing)")
         fig.tight_layout()
-        paths.append(_save(fig, out / "cylinder_forces.png"))
+        paths.append(save_figure(fig, out / "cylinder_forces.png"))
         plt.close(fig)
     if "energy_kinetic" in result:
         fig, ax = plt.subplots(figsize=(8, 3))
@@ -65,6 +66,6 @@ def plot_result(result: Result, out: str | Path) -> list[Path]:
         ax.grid(alpha=0.3)
         ax.legend()
         fig.tight_layout()
-        paths.append(_save(fig, out / "energy.png"))
+        paths.append(save_figure(fig, out / "energy.png"))
         plt.close(fig)
     return paths

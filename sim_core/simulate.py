@@ -15,6 +15,7 @@ from scipy.integrate import BDF, RK45
 from .assemble import build_model
 from .errors import SimulationError
 from .result import Result
+from .scene import SOLVER_METHODS
 from .statics import static_equilibrium
 
 
@@ -57,9 +58,6 @@ class _CountingRHS:
             raise SimulationError(t, f"{reason} ({self.failures} consecutive failed stage "
                                      "evaluations; step size could not recover)", last_state=y)
         return np.full(len(y), self.BIG)
-
-
-METHODS = ("RK45", "BDF", "auto")
 
 
 class StiffnessDetector:
@@ -182,8 +180,8 @@ def integrate(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
     is exhausted, or on Ctrl-C (KeyboardInterrupt); the outputs reached so far are attached, so
     a budgeted or interrupted run still yields a partial result."""
     method = sol.get("method", "RK45")
-    if method not in METHODS:
-        raise ValueError(f"solver.method = {method!r}: must be one of {METHODS}")
+    if method not in SOLVER_METHODS:
+        raise ValueError(f"solver.method = {method!r}: must be one of {SOLVER_METHODS}")
     t_eval = np.linspace(0.0, t_end, sol["n_output"])
     rhs = _CountingRHS(model)
     kwargs = {"max_step": sol["max_step"]} if "max_step" in sol else {}
@@ -217,36 +215,37 @@ def integrate(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
         return out
 
     try:
-        try:
-            while solver.status == "running":
-                msg = solver.step()
-                if solver.status == "failed" or not np.all(np.isfinite(solver.y)):
-                    why = (f" after {rhs.failures} failed stage evaluations ({rhs.last_reason})"
-                           if rhs.failures else "")
-                    name = "BDF" if isinstance(solver, BDF) else "RK45"
-                    raise SimulationError(solver.t, f"{name} failed: {msg}{why}", step=solver.step_size,
-                                          last_state=solver.y)
-                steps.append(solver.t - solver.t_old)
-                if k_out < len(t_eval) and t_eval[k_out] <= solver.t:
-                    dense = solver.dense_output()
-                    while k_out < len(t_eval) and t_eval[k_out] <= solver.t:
-                        ys.append(dense(t_eval[k_out]))
-                        k_out += 1
-                if progress is not None:
-                    progress(solver.t, time.perf_counter() - wall0)
-                if budget is not None and solver.status == "running" \
-                        and time.perf_counter() - wall0 > budget:
-                    raise SimulationError(solver.t, f"wall-clock budget solver.max_wall_s = {budget:g} s "
-                                          f"exhausted (last step {solver.step_size:.3g} s)",
-                                          step=solver.step_size, last_state=solver.y)
-                if switch is not None and solver.status == "running":
-                    old = solver
-                    solver = switch.after_step(solver, make)
-                    if solver is not old:
-                        njev += int(getattr(old, "njev", 0))
-        except KeyboardInterrupt:          # Ctrl-C keeps what was computed, like a budget
-            raise SimulationError(solver.t, "interrupted by the user (KeyboardInterrupt)",
-                                  step=solver.step_size, last_state=solver.y) from None
+        while solver.status == "running":
+            msg = solver.step()
+            if solver.status == "failed" or not np.all(np.isfinite(solver.y)):
+                why = (f" after {rhs.failures} failed stage evaluations ({rhs.last_reason})"
+                       if rhs.failures else "")
+                name = "BDF" if isinstance(solver, BDF) else "RK45"
+                raise SimulationError(solver.t, f"{name} failed: {msg}{why}", step=solver.step_size,
+                                      last_state=solver.y)
+            steps.append(solver.t - solver.t_old)
+            if k_out < len(t_eval) and t_eval[k_out] <= solver.t:
+                dense = solver.dense_output()
+                while k_out < len(t_eval) and t_eval[k_out] <= solver.t:
+                    ys.append(dense(t_eval[k_out]))
+                    k_out += 1
+            if progress is not None:
+                progress(solver.t, time.perf_counter() - wall0)
+            if budget is not None and solver.status == "running" \
+                    and time.perf_counter() - wall0 > budget:
+                raise SimulationError(solver.t, f"wall-clock budget solver.max_wall_s = {budget:g} s "
+                                      f"exhausted (last step {solver.step_size:.3g} s)",
+                                      step=solver.step_size, last_state=solver.y)
+            if switch is not None and solver.status == "running":
+                old = solver
+                solver = switch.after_step(solver, make)
+                if solver is not old:
+                    njev += int(getattr(old, "njev", 0))
+    except KeyboardInterrupt:              # Ctrl-C keeps what was computed, like a budget
+        exc = SimulationError(solver.t, "interrupted by the user (KeyboardInterrupt)",
+                              step=solver.step_size, last_state=solver.y)
+        exc.partial = (t_eval[:len(ys)], np.array(ys), stats())
+        raise exc from None
     except SimulationError as exc:
         # keep what was computed: the caller turns it into a partial Result (exc.result)
         exc.partial = (t_eval[:len(ys)], np.array(ys), stats())
