@@ -449,10 +449,18 @@ def _first_hit(L, v, a, stop):
     if (stop > L and v <= 0 and a <= 0) or (stop < L and v >= 0 and a >= 0) or stop == L:
         return math.inf
     if abs(a) < 1e-15:
-        return (stop - L) / v if v != 0 else math.inf
+        # linear; a stop behind the motion is never hit (this returned a negative time, and a
+        # 1e-15 m/s^2 braking command at full speed jumped the stroke to the far end stop)
+        t = (stop - L) / v if v != 0 else math.inf
+        return t if t > 0 else math.inf
     disc = v * v + 2 * a * (stop - L)
     if disc < 0:
         return math.inf
+    # a t^2/2 + v t + (L - stop) = 0 in the cancellation-free form q = -(v + sign(v) r)
     r = math.sqrt(disc)
-    roots = [t for t in ((-v - r) / a, (-v + r) / a) if t > 1e-15]
+    q = -(v + math.copysign(r, v))
+    cands = [q / a]
+    if q != 0.0:
+        cands.append(2.0 * (L - stop) / q)
+    roots = [t for t in cands if t > 1e-15]
     return min(roots) if roots else math.inf

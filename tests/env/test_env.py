@@ -192,3 +192,23 @@ def test_paper_fidelity_steps_the_full_model():
     assert np.all(np.isfinite(o_p)) and np.max(np.abs(o_p[5:7])) < 1e-2
     n = env._ts.model.n_dof                              # target time: end of the last step
     assert np.max(np.abs(env._ts.model.constraint_violation(env.dt, env._y[:n], env._y[n:]))) < 1e-6
+
+
+@pytest.mark.parametrize("a", [-8.9e-16, 0.0, -1e-14, -1e-9, -1e-6, 1e-14])
+def test_tiny_acceleration_at_speed_hits_no_end_stop(a):
+    """Regression: a tiny braking command at full speed mid-stroke must not 'hit' the far end
+    stop (the textbook quadratic root (-v + r) / a cancelled to a spurious small positive time,
+    and the stroke jumped to L_min).  Exact kinematics: L + v dt + a dt^2 / 2."""
+    from boom_env.telescopic_env import _first_hit
+    env = TelescopicBoomEnv(task="extraction")
+    L, v = 3.0, env.v_max
+    segs, L1, v1, sat, stop = env._segments(L, v, a)
+    assert not stop
+    assert L1 == pytest.approx(L + v * env.dt + 0.5 * min(a, 0.0) * env.dt ** 2, abs=1e-15)
+    # the far stop is reached only after reversing: t = roots of a t^2/2 + v t + (L - L_min)
+    # (|a| < 1e-15 is treated as a = 0: never)
+    t_hit = _first_hit(L, v, a, env.L_min)
+    assert t_hit > 1e3
+    if a < -1e-15:
+        t_exact = (-v - np.sqrt(v * v - 2 * a * (L - env.L_min))) / a
+        assert t_hit == pytest.approx(t_exact, rel=1e-9)
