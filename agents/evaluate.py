@@ -19,6 +19,10 @@ Evaluation protocol (identical for every controller)
 * ``final_stroke_error_m``: |L_s - L*| at the end of the episode (30 s).
 * ``residual_tip_rms_m``: RMS of the tip deflection |d| (from the static tip at the current L_s)
   over the 4 s after ``stop_time_s`` (control-step samples).
+* ``tip_rms_16_20_m``: RMS of |d| over the same fixed window for every controller, 16-20 s
+  (the 4 s after the end of the paper's cubic schedule): controllers that keep moving after
+  reaching the target (a policy damping the vibration actively) are then compared at the same
+  time, not each after its own stop.
 * ``peak_tip_deflection_m``: max |d| over the episode.
 * ``peak_telescopic_force_N``: max |F| of the telescopic cylinder force, F = F_rigid + Gamma . q''
   (see :func:`telescopic_force`).
@@ -41,6 +45,7 @@ import numpy as np
 STROKE_TOL = 0.01        # m, "reaches the target" (issue: within 1 cm)
 SPEED_TOL = 5e-3         # m/s, the env's tol_speed
 RESIDUAL_WINDOW = 4.0    # s
+FIXED_WINDOW = (16.0, 20.0)   # s, after the end of the paper's cubic schedule
 ENV_ID = "boom_env/TelescopicExtraction-v0"
 
 
@@ -127,11 +132,14 @@ def metrics(tr: Trace) -> dict:
     t_stop = _settle_time(tr.t, (err <= STROKE_TOL) & (np.abs(tr.rate) <= SPEED_TOL))
     t0 = t_stop if t_stop is not None else tr.t[-1] - RESIDUAL_WINDOW
     win = (tr.t >= t0 - 1e-9) & (tr.t <= t0 + RESIDUAL_WINDOW + 1e-9)
+    fixed = (tr.t >= FIXED_WINDOW[0] - 1e-9) & (tr.t <= FIXED_WINDOW[1] + 1e-9)
     return {"time_to_target_s": t_target,
             "stop_time_s": t_stop,
             "final_stroke_error_m": float(err[-1]),
             "residual_tip_rms_m": float(np.sqrt(np.mean(tr.deflection[win] ** 2))),
             "residual_window_s": float(tr.t[win][-1] - tr.t[win][0]),
+            "tip_rms_16_20_m": (float(np.sqrt(np.mean(tr.deflection[fixed] ** 2)))
+                                if fixed.any() else None),
             "peak_tip_deflection_m": float(tr.deflection.max()),
             "peak_telescopic_force_N": float(np.abs(tr.force).max()),
             "episode_return": tr.total_return}
@@ -168,23 +176,41 @@ class PPOPolicy:
         meta = Path(model_path).with_name(Path(model_path).stem + "_meta.json")
         if not meta.exists():
             meta = Path(model_path).with_name("model_meta.json")
-        self.du_max, self.repeat, self._held = None, 1, 0.0
+        self.du_max, self.repeat, self._held, self.residual = None, 1, 0.0, None
         if meta.exists():
             info = json.loads(meta.read_text())
             self.du_max = info.get("du_max")
             self.repeat = int(info.get("action_repeat") or 1)
+            self.residual = info.get("residual")
+        self.tracker = None
         if vecnorm_path.exists():
             with open(vecnorm_path, "rb") as f:
                 vn = pickle.load(f)
             self.obs_rms, self.clip_obs, self.eps = vn.obs_rms, vn.clip_obs, vn.epsilon
 
+    def bind(self, env) -> None:
+        """Build the residual policy's base controller for ``env`` (its dt, a_max, t_max)."""
+        if self.residual:
+            from .schedules import by_name
+            from .wrappers import ScheduleTracker
+            u = env.unwrapped
+            self.tracker = ScheduleTracker(by_name(self.residual["schedule"]), u.dt, u.a_max,
+                                           int(round(u.t_max / u.dt)), self.residual["scale"],
+                                           self.residual["omega"])
+
     def __call__(self, obs: np.ndarray, k: int) -> float:
+        if self.tracker is not None:       # agents.wrappers.ResidualOnSchedule
+            if k == 0:
+                self.tracker.reset(obs[0])
+            return self.tracker.command(obs, k, self._act(self.tracker.augment(obs, k)))
         if k % self.repeat:                # agents.wrappers.ActionRepeat: zero-order hold
             return self._held
         self._held = self._act(obs)
         return self._held
 
     def _act(self, obs: np.ndarray) -> float:
+        if self.residual and self.tracker is None:
+            raise RuntimeError("residual policy: call bind(env) before acting")
         x = np.asarray(obs, dtype=np.float64)
         if self.obs_rms is not None:
             x = np.clip((x - self.obs_rms.mean) / np.sqrt(self.obs_rms.var + self.eps),
@@ -219,6 +245,7 @@ def evaluate(model: str | list | None = None, episodes: int = 1, seed: int = 0,
     for mp in models:
         name = "ppo" if len(models) == 1 else f"ppo_{Path(mp).parent.name}"
         controllers[name] = PPOPolicy(mp, a_max=u.a_max)
+        controllers[name].bind(env)
     results, traces = {}, {}
     for name, pol in controllers.items():
         ms = []

@@ -115,3 +115,12 @@ def zv_trapezoid(v_max: float = V_MAX, travel: float = TRAVEL, duration: float =
 def all_schedules(payload: float = 25000.0, angle_deg: float = 60.0) -> list[RateSchedule]:
     """The scripted baselines of the comparison, in report order."""
     return [cubic(), trapezoid(), zv_trapezoid(payload=payload, angle_deg=angle_deg)]
+
+
+def by_name(name: str, payload: float = 25000.0, angle_deg: float = 60.0) -> RateSchedule:
+    """The scripted baseline called ``name`` (one of :func:`all_schedules`)."""
+    makers = {"cubic": cubic, "trapezoid": trapezoid,
+              "zv_trapezoid": lambda: zv_trapezoid(payload=payload, angle_deg=angle_deg)}
+    if name not in makers:
+        raise ValueError(f"schedule = {name!r}: allowed {sorted(makers)}")
+    return makers[name]()

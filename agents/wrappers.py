@@ -92,3 +92,111 @@ class ActionRepeat(gym.Wrapper):
             if term or trunc:
                 break
         return obs, total, term, trunc, info
+
+
+class ScheduleTracker:
+    """Feed-forward of a scripted schedule plus a tracking feedback on its stroke reference:
+    the base controller of residual policy learning (Johannink et al. 2019, "Residual
+    reinforcement learning for robot control"; Silver et al. 2018, "Residual policy learning").
+
+    For env step k (time t_k = k dt) the command is
+
+        a_k / a_max = clip(a_ff,k - (kp e_k + kd e'_k) / a_max + scale * u_k, -1, 1),
+
+    with a_ff,k the schedule's mean acceleration over the step (``RateSchedule.actions``),
+    e_k = L_s - L_ref(t_k), e'_k = v - v_ref(t_k) the deviation from the schedule's own stroke
+    history (L_ref = L_start + trapezoidal integral of v_ref: exact for the env's piecewise
+    constant acceleration, so e = e' = 0 when u = 0) and u_k in [-1, 1] the residual.  After the
+    schedule's end the reference rests at its last value.  With u = 0 the command is the
+    scripted schedule exactly; the feedback (kp = w^2, kd = 2 w, w = 1 rad/s: critically damped,
+    below the 2.7 rad/s first bending mode at full extension so it leaves the vibration band to
+    the residual) only acts on deviations the residual or the exploration noise caused and
+    brings the stroke back to the schedule's end point.  Everything it uses (t, L_s, v) is in the
+    env observation, so the wrapped problem stays Markov; e and e' are appended to the
+    observation because the policy needs them in that form."""
+
+    def __init__(self, schedule, dt: float, a_max: float, n_steps: int, scale: float = 0.25,
+                 omega: float = 1.0):
+        if not 0 < scale <= 2:
+            raise ValueError(f"scale = {scale!r}: allowed (0, 2]")
+        if not omega >= 0:
+            raise ValueError(f"omega = {omega!r} rad/s: allowed >= 0")
+        self.name, self.scale = schedule.name, float(scale)
+        self.a_max, self.dt = float(a_max), float(dt)
+        self.kp, self.kd = omega * omega, 2.0 * omega
+        self.a_ff = schedule.actions(dt, a_max, n_steps)
+        t = dt * np.arange(n_steps + 1)
+        self.v_ref = np.array([schedule.rate(tk) for tk in t])
+        self.dL_ref = np.concatenate([[0.0], np.cumsum(0.5 * dt * (self.v_ref[1:] + self.v_ref[:-1]))])
+        self.L0 = 0.0
+
+    def reset(self, stroke: float) -> None:
+        """Anchor the stroke reference at the episode's start piston length (m)."""
+        self.L0 = float(stroke)
+
+    def error(self, obs, k: int) -> tuple[float, float]:
+        """(e m, e' m/s) at step boundary k (obs = the env observation there)."""
+        j = min(k, len(self.v_ref) - 1)
+        return float(obs[0]) - (self.L0 + self.dL_ref[j]), float(obs[1]) - self.v_ref[j]
+
+    def augment(self, obs, k: int) -> np.ndarray:
+        e, ed = self.error(obs, k)
+        return np.concatenate([np.asarray(obs, dtype=np.float32),
+                               np.array([e, ed], dtype=np.float32)])
+
+    def command(self, obs, k: int, u) -> float:
+        """Normalised env action for residual u at step k."""
+        u = float(np.clip(np.asarray(u, dtype=np.float64).reshape(-1)[0], -1.0, 1.0))
+        e, ed = self.error(obs, k)
+        ff = float(self.a_ff[k]) if k < len(self.a_ff) else 0.0
+        return float(np.clip(ff - (self.kp * e + self.kd * ed) / self.a_max + self.scale * u,
+                             -1.0, 1.0))
+
+
+class ResidualOnSchedule(gym.Wrapper):
+    """The policy's action is a residual on a scripted schedule with tracking feedback
+    (:class:`ScheduleTracker`); observation = env observation + (e m, e' m/s), the deviation
+    from the schedule's stroke history (bounds +-(L_max - L_min), +-2 v_max).  Reward: the env's
+    minus a tracking term  w_track * (e / e_ref)^2 * dt,  e_ref = 1 cm (the comparison's stroke
+    tolerance), default w_track = 0 (the env's reward unchanged).  Not combinable with
+    :class:`RandomStart` (the reference starts at the reset stroke and travels the schedule's
+    distance, so the start must be the task's)."""
+
+    E_REF = 0.01    # m
+
+    def __init__(self, env: gym.Env, schedule=None, scale: float = 0.25, omega: float = 1.0,
+                 w_track: float = 0.0):
+        super().__init__(env)
+        if not w_track >= 0:
+            raise ValueError(f"w_track = {w_track!r}: allowed >= 0")
+        self.w_track = float(w_track)
+        u = env.unwrapped
+        if schedule is None:
+            from .schedules import cubic
+            schedule = cubic()
+        n_steps = int(round(u.t_max / u.dt))
+        self.tracker = ScheduleTracker(schedule, u.dt, u.a_max, n_steps, scale, omega)
+        lo, hi = env.observation_space.low, env.observation_space.high
+        span = float(hi[0] - lo[0])
+        vm = float(hi[1])
+        self.observation_space = gym.spaces.Box(
+            np.concatenate([lo, [-span, -2 * vm]]).astype(np.float32),
+            np.concatenate([hi, [span, 2 * vm]]).astype(np.float32), dtype=np.float32)
+        self._k, self._obs = 0, None
+
+    def reset(self, **kwargs):
+        obs, info = self.env.reset(**kwargs)
+        self.tracker.reset(obs[0])
+        self._k, self._obs = 0, obs
+        return self.tracker.augment(obs, 0), info
+
+    def step(self, action):
+        a = self.tracker.command(self._obs, self._k, action)
+        obs, r, term, trunc, info = self.env.step(np.array([a], dtype=np.float32))
+        self._k += 1
+        self._obs = obs
+        aug = self.tracker.augment(obs, self._k)
+        if self.w_track:
+            r = float(r) - self.w_track * (float(aug[-2]) / self.E_REF) ** 2 * self.env.unwrapped.dt
+        info = dict(info, residual_command=a)
+        return aug, r, term, trunc, info

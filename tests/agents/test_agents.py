@@ -166,3 +166,104 @@ def test_ppo_policy_holds_its_action(tmp_path):
         acts.append(pol(obs, k))
         obs, *_ = env.step(np.array([acts[-1]], dtype=np.float32))
     assert acts[0] == acts[1] == acts[2] == acts[3] and acts[4] == acts[5] == acts[6] == acts[7]
+
+
+def _residual_env():
+    import gymnasium as gym
+
+    import boom_env  # noqa: F401
+    from agents.wrappers import ResidualOnSchedule
+    return ResidualOnSchedule(gym.make("boom_env/TelescopicExtraction-v0", tol_deflection=0.0),
+                              S.cubic(), scale=0.25, omega=1.0)
+
+
+def test_zero_residual_is_the_scripted_schedule():
+    """With u = 0 the residual wrapper commands the cubic schedule itself: its stroke reference
+    is the env's exact kinematics of the schedule's actions, so the tracking error stays at the
+    float32 rounding of the actions (N dt^2 a_max 2^-24 ~ 1e-8 m per step, summed) and the
+    feedback adds nothing; stroke and tip deflection equal the scripted run's."""
+    env = _residual_env()
+    obs, _ = env.reset(seed=0)
+    assert env.observation_space.contains(obs) and obs.shape == (11,)
+    ref = ev.run_episode(ev.make_eval_env(), ev.scripted_policy(S.cubic(), DT, A_MAX, N), seed=0)
+    strokes, defl = [obs[0]], [0.0]
+    for _ in range(N):
+        obs, r, term, trunc, info = env.step(np.zeros(1, np.float32))
+        assert abs(obs[9]) < 1e-6 and abs(obs[10]) < 1e-6         # e (m), e' (m/s)
+        strokes.append(info["stroke"])
+        defl.append(float(np.hypot(*info["tip_deflection"])))
+        if term or trunc:
+            break
+    np.testing.assert_allclose(strokes, ref.stroke, atol=1e-6)
+    np.testing.assert_allclose(defl, ref.deflection, atol=1e-8)
+
+
+def test_tracking_feedback_returns_a_disturbed_stroke_to_the_schedule_end():
+    """A constant residual of +1 (scale 0.25: d = 0.0625 m/s^2) for the first 2 s pushes the
+    stroke ahead of the schedule: closed loop e = d / omega^2 (1 - (1 + omega t) exp(-omega t)),
+    3.7 cm at 2 s; then the critically damped feedback (omega 1 rad/s) brings it back as
+    (1 + omega t) exp(-omega t), < 1e-9 m left 28 s later, so the episode ends at 8 m within
+    1 mm and at rest.  The appended observation is the deviation L_s - L_ref."""
+    env = _residual_env()
+    obs, _ = env.reset(seed=0)
+    peak = 0.0
+    for k in range(N):
+        u = 1.0 if k < 40 else 0.0
+        obs, r, term, trunc, info = env.step(np.array([u], np.float32))
+        peak = max(peak, abs(obs[9]))
+        if term or trunc:
+            break
+    assert 0.03 < peak < 0.045                # the disturbance moved the stroke as predicted
+    assert abs(info["stroke"] - 8.0) < 1e-3 and abs(info["stroke_rate"]) < 1e-3
+
+
+def test_residual_policy_evaluation_replays_the_training_wrapper(tmp_path):
+    """A residual PPO model (a few hundred steps) acting through agents.evaluate.PPOPolicy gives
+    the same strokes as the same model acting through the training wrapper: the evaluation
+    rebuilds the schedule, feedback and observation of ResidualOnSchedule from the model's
+    meta file."""
+    from agents.train_ppo import train
+    path = train(256, seed=3, out=tmp_path / "run", n_envs=1, vec="dummy", checkpoint_every=0,
+                 progress=False, residual="cubic")
+    meta = json.loads((tmp_path / "run" / "model_meta.json").read_text())
+    assert meta["action_mode"] == "residual" and meta["residual"]["schedule"] == "cubic"
+    pol = ev.PPOPolicy(path)
+    env = ev.make_eval_env()
+    pol.bind(env)
+    tr = ev.run_episode(env, pol, 0)
+    wrapped = _residual_env()
+    obs, _ = wrapped.reset(seed=0)
+    strokes = [obs[0]]
+    for _ in range(N):
+        obs, r, term, trunc, info = wrapped.step(np.array([pol._act(obs)], np.float32))
+        strokes.append(info["stroke"])
+        if term or trunc:
+            break
+    np.testing.assert_allclose(strokes, tr.stroke, atol=1e-9)
+    with pytest.raises(ValueError, match="random_start"):
+        train(64, seed=0, out=tmp_path / "bad", n_envs=1, vec="dummy", checkpoint_every=0,
+              progress=False, residual="cubic", random_start=0.5)
+    with pytest.raises(ValueError, match="schedule"):
+        S.by_name("sinusoid")
+
+
+def test_tracking_term_of_the_residual_training_reward():
+    """w_track adds -(e / 1 cm)^2 dt to the env's reward, nothing else changes."""
+    import gymnasium as gym
+
+    import boom_env  # noqa: F401
+    from agents.wrappers import ResidualOnSchedule
+    envs = [ResidualOnSchedule(gym.make("boom_env/TelescopicExtraction-v0", tol_deflection=0.0),
+                               S.cubic(), w_track=w) for w in (0.0, 1.0)]
+    for e in envs:
+        e.reset(seed=0)
+    seen = 0.0
+    for k in range(60):
+        u = np.array([0.8 if k < 30 else -0.3], np.float32)
+        (o0, r0, *_), (o1, r1, *_) = (e.step(u) for e in envs)
+        np.testing.assert_array_equal(o0, o1)
+        assert r1 == pytest.approx(r0 - (float(o1[9]) / 0.01) ** 2 * DT, rel=1e-12, abs=1e-12)
+        seen = max(seen, abs(float(o1[9])))
+    assert seen > 1e-3                        # the term was exercised
+    with pytest.raises(ValueError, match="w_track"):
+        ResidualOnSchedule(envs[0].env, S.cubic(), w_track=-1.0)
