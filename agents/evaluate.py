@@ -100,7 +100,9 @@ def run_episode(env, policy: Callable[[np.ndarray, int], float], seed: int) -> T
     """Run one full episode; ``policy(obs, k)`` returns the normalised action of step k."""
     obs, info = env.reset(seed=seed)
     u = env.unwrapped
-    rows = [(0.0, info["stroke"], info["stroke_rate"], 0.0, 0.0, telescopic_force(env, 0.0))]
+    rom_force = u.fidelity == "rl"        # the force formula needs the ROM's modal state
+    rows = [(0.0, info["stroke"], info["stroke_rate"], 0.0, 0.0,
+             telescopic_force(env, 0.0) if rom_force else math.nan)]
     total, k = 0.0, 0
     while True:
         act = float(np.clip(policy(obs, k), -1.0, 1.0))
@@ -109,7 +111,8 @@ def run_episode(env, policy: Callable[[np.ndarray, int], float], seed: int) -> T
         k += 1
         a = float(obs[2])
         rows.append((info["time"], info["stroke"], info["stroke_rate"], a,
-                     float(np.hypot(*info["tip_deflection"])), telescopic_force(env, a)))
+                     float(np.hypot(*info["tip_deflection"])),
+                     telescopic_force(env, a) if rom_force else math.nan))
         if term or trunc:
             break
     arr = np.array(rows)
@@ -141,7 +144,8 @@ def metrics(tr: Trace) -> dict:
             "tip_rms_16_20_m": (float(np.sqrt(np.mean(tr.deflection[fixed] ** 2)))
                                 if fixed.any() else None),
             "peak_tip_deflection_m": float(tr.deflection.max()),
-            "peak_telescopic_force_N": float(np.abs(tr.force).max()),
+            "peak_telescopic_force_N": (None if np.all(np.isnan(tr.force))
+                                        else float(np.nanmax(np.abs(tr.force)))),
             "episode_return": tr.total_return}
 
 
@@ -230,12 +234,18 @@ def _vecnorm_for(model_path: Path) -> Path:
 
 
 def evaluate(model: str | list | None = None, episodes: int = 1, seed: int = 0,
-             payload_range: tuple[float, float] | None = None) -> tuple[dict, dict]:
+             payload_range: tuple[float, float] | None = None, fidelity: str = "rl",
+             only: list[str] | None = None) -> tuple[dict, dict]:
     """Run every scripted schedule (and the PPO policy of every ``model`` path: "ppo" for one,
     "ppo_<label>" for several, label = the parent directory name) on seeds seed..seed+K-1.
+    ``fidelity="paper"`` runs the env on the full sim_core model (slow; the telescopic force is
+    then not computed); ``only`` restricts the controllers to these names.
     Returns ({name: mean metrics}, {name: first-episode Trace})."""
     from . import schedules as S
-    env = make_eval_env(payload_range=payload_range) if payload_range else make_eval_env()
+    kw = {"fidelity": fidelity}
+    if payload_range:
+        kw["payload_range"] = payload_range
+    env = make_eval_env(**kw)
     u = env.unwrapped
     n_steps = int(round(u.t_max / u.dt))
     controllers: dict[str, Callable] = {}
@@ -246,6 +256,11 @@ def evaluate(model: str | list | None = None, episodes: int = 1, seed: int = 0,
         name = "ppo" if len(models) == 1 else f"ppo_{Path(mp).parent.name}"
         controllers[name] = PPOPolicy(mp, a_max=u.a_max)
         controllers[name].bind(env)
+    if only:
+        unknown = set(only) - set(controllers)
+        if unknown:
+            raise ValueError(f"only = {sorted(unknown)}: allowed {sorted(controllers)}")
+        controllers = {k: v for k, v in controllers.items() if k in only}
     results, traces = {}, {}
     for name, pol in controllers.items():
         ms = []
@@ -304,6 +319,10 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--payload-range", type=float, nargs=2, metavar=("LO", "HI"),
                     help="randomise the payload (kg) per episode within the modal tables' range")
+    ap.add_argument("--fidelity", choices=("rl", "paper"), default="rl",
+                    help="env fidelity: rl (modal ROM, default) or paper (full model, slow)")
+    ap.add_argument("--only", nargs="+", metavar="NAME",
+                    help="evaluate only these controllers (e.g. cubic ppo)")
     ap.add_argument("--json", action="store_true", help="print the metrics as one JSON object")
     ap.add_argument("--out", help="also write the JSON here")
     ap.add_argument("--figure", default="agents/results/evaluation.png",
@@ -316,7 +335,8 @@ def main(argv=None) -> int:
             ap.error(f"--model {mp}: file not found")
     res, traces = evaluate(args.model[0] if args.model and len(args.model) == 1 else args.model,
                            args.episodes, args.seed,
-                           tuple(args.payload_range) if args.payload_range else None)
+                           tuple(args.payload_range) if args.payload_range else None,
+                           args.fidelity, args.only)
     text = json.dumps(res, indent=2)
     if args.out:
         atomic_write_text(args.out, text + "\n")

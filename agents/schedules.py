@@ -112,15 +112,21 @@ def zv_trapezoid(v_max: float = V_MAX, travel: float = TRAVEL, duration: float =
     return RateSchedule("zv_trapezoid", v, duration)
 
 
-def all_schedules(payload: float = 25000.0, angle_deg: float = 60.0) -> list[RateSchedule]:
-    """The scripted baselines of the comparison, in report order."""
-    return [cubic(), trapezoid(), zv_trapezoid(payload=payload, angle_deg=angle_deg)]
+NAMES = ("cubic", "trapezoid", "zv_trapezoid")      # report order
 
 
 def by_name(name: str, payload: float = 25000.0, angle_deg: float = 60.0) -> RateSchedule:
-    """The scripted baseline called ``name`` (one of :func:`all_schedules`)."""
-    makers = {"cubic": cubic, "trapezoid": trapezoid,
-              "zv_trapezoid": lambda: zv_trapezoid(payload=payload, angle_deg=angle_deg)}
-    if name not in makers:
-        raise ValueError(f"schedule = {name!r}: allowed {sorted(makers)}")
-    return makers[name]()
+    """The scripted baseline called ``name`` (one of ``NAMES``; the ZV shaper is tuned to the
+    payload kg and luffing angle deg)."""
+    if name == "cubic":
+        return cubic()
+    if name == "trapezoid":
+        return trapezoid()
+    if name == "zv_trapezoid":
+        return zv_trapezoid(payload=payload, angle_deg=angle_deg)
+    raise ValueError(f"schedule = {name!r}: allowed {list(NAMES)}")
+
+
+def all_schedules(payload: float = 25000.0, angle_deg: float = 60.0) -> list[RateSchedule]:
+    """The scripted baselines of the comparison, in report order."""
+    return [by_name(n, payload, angle_deg) for n in NAMES]

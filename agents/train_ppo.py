@@ -218,16 +218,18 @@ def train(timesteps: int, seed: int, out: str | os.PathLike, n_envs: int | None 
         venv.save(str(out / "model_vecnormalize.tmp.pkl"))
         os.replace(out / "model_vecnormalize.tmp.pkl", out / "model_vecnormalize.pkl")
         import json
-        (out / "model_meta.json").write_text(json.dumps(
+        from .evaluate import atomic_write_text
+        atomic_write_text(out / "model_meta.json", json.dumps(
             {"env_id": ENV_ID, "action_mode": ("increment" if du_max else
                                                "residual" if res else "acceleration"),
              "du_max": du_max, "action_repeat": action_repeat, "residual": res,
              "env_kwargs": env_kwargs,
              "random_start": random_start,
              "seed": seed, "timesteps": int(model.num_timesteps)}) + "\n")
-        (out / "train_info.txt").write_text(
-            f"timesteps {model.num_timesteps}\nseed {seed}\nn_envs {n_envs}\nvec {vec}\n"
-            f"wall_s {wall:.1f}\nhyper {hyper}\npolicy_kwargs {policy_kwargs}\n")
+        atomic_write_text(out / "train_info.txt",
+                          f"timesteps {model.num_timesteps}\nseed {seed}\nn_envs {n_envs}\n"
+                          f"vec {vec}\nwall_s {wall:.1f}\nhyper {hyper}\n"
+                          f"policy_kwargs {policy_kwargs}\n")
         venv.close()
     return path
 

@@ -53,10 +53,8 @@ ROWS = [
 
 
 def _atomic_write(path: str, text: str) -> None:
-    tmp = path + ".tmp"
-    with open(tmp, "w") as fh:
-        fh.write(text)
-    os.replace(tmp, path)
+    from sim_core.result import atomic_write_bytes
+    atomic_write_bytes(path, text.encode())
 
 
 class _TimeLimit(Exception):
