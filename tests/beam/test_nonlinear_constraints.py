@@ -39,3 +39,31 @@ def test_kkt_clamp_equals_eliminated_clamp(rng):
     # reaction force at the root: linear rows 0..2 are r_1 = 0
     R_lin = lin.reactions(0.0, z, zd)[:3]
     np.testing.assert_allclose(lam[:3], R_lin, rtol=1e-6, atol=1e-6 * np.max(np.abs(R_lin)))
+
+
+def test_selection_fast_path_equals_the_dense_projection():
+    """Model.reduced_mass_force takes P^T M P as a sub-matrix when P only selects (and signs)
+    coordinates; the dense products give the same numbers (bitwise: one non-zero term per sum,
+    times +-1).  A P whose columns mix coordinates keeps the dense route."""
+    from sim_core.model import _selection
+    from sim_core.telescopic import TelescopicParams, build_telescopic
+    m = build_telescopic(TelescopicParams(n_nodes=3)).model
+    assert m._sel is not None
+    rng = np.random.default_rng(1)
+    z = 1e-3 * rng.standard_normal(m.n_dof)
+    zd = 1e-2 * rng.standard_normal(m.n_dof)
+    Mr, Fr = m.reduced_mass_force(0.2, z, zd)
+    sel, m._sel = m._sel, None
+    try:
+        Mr0, Fr0 = m.reduced_mass_force(0.2, z, zd)
+    finally:
+        m._sel = sel
+    np.testing.assert_array_equal(Mr, Mr0)
+    np.testing.assert_array_equal(Fr, Fr0)
+    P = np.zeros((3, 2))
+    P[0, 0], P[2, 1] = 1.0, -1.0
+    rows, vals = _selection(P)
+    assert list(rows) == [0, 2] and list(vals) == [1.0, -1.0]
+    P[1, 1] = 0.5                                  # column 1 mixes two coordinates
+    assert _selection(P) is None
+    assert _selection(np.eye(3)[:, [0, 0]]) is None    # same row twice
