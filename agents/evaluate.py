@@ -23,6 +23,11 @@ Evaluation protocol (identical for every controller)
   (the 4 s after the end of the paper's cubic schedule): controllers that keep moving after
   reaching the target (a policy damping the vibration actively) are then compared at the same
   time, not each after its own stop.
+* ``residual_tip_oscillation_m``: RMS of d - mean(d) (the deflection vector about its own mean)
+  over the same window: the vibration alone.  It equals the residual RMS when the deflection
+  reference is the model's own static tip (the modal ROM); with ``fidelity="paper"`` the
+  env's reference (the tables' static tip change added to the full model's tip at reset)
+  is off by mm at full extension, and this metric is not affected by that offset.
 * ``peak_tip_deflection_m``: max |d| over the episode.
 * ``peak_telescopic_force_N``: max |F| of the telescopic cylinder force, F = F_rigid + Gamma . q''
   (see :func:`telescopic_force`).
@@ -61,6 +66,7 @@ class Trace:
     force: np.ndarray        # N, telescopic cylinder force
     target: float            # m
     total_return: float
+    deflection_xz: np.ndarray | None = None   # (n, 2) m, the deflection vector (dX, dZ)
 
 
 def make_eval_env(**kwargs):
@@ -102,7 +108,7 @@ def run_episode(env, policy: Callable[[np.ndarray, int], float], seed: int) -> T
     u = env.unwrapped
     rom_force = u.fidelity == "rl"        # the force formula needs the ROM's modal state
     rows = [(0.0, info["stroke"], info["stroke_rate"], 0.0, 0.0,
-             telescopic_force(env, 0.0) if rom_force else math.nan)]
+             telescopic_force(env, 0.0) if rom_force else math.nan, 0.0, 0.0)]
     total, k = 0.0, 0
     while True:
         act = float(np.clip(policy(obs, k), -1.0, 1.0))
@@ -112,12 +118,13 @@ def run_episode(env, policy: Callable[[np.ndarray, int], float], seed: int) -> T
         a = float(obs[2])
         rows.append((info["time"], info["stroke"], info["stroke_rate"], a,
                      float(np.hypot(*info["tip_deflection"])),
-                     telescopic_force(env, a) if rom_force else math.nan))
+                     telescopic_force(env, a) if rom_force else math.nan,
+                     *map(float, info["tip_deflection"])))
         if term or trunc:
             break
     arr = np.array(rows)
     return Trace(arr[:, 0], arr[:, 1], arr[:, 2], arr[:, 3], arr[:, 4], arr[:, 5],
-                 float(u.L_target), float(total))
+                 float(u.L_target), float(total), arr[:, 6:8])
 
 
 def _settle_time(t: np.ndarray, ok: np.ndarray) -> float | None:
@@ -140,6 +147,7 @@ def metrics(tr: Trace) -> dict:
             "stop_time_s": t_stop,
             "final_stroke_error_m": float(err[-1]),
             "residual_tip_rms_m": float(np.sqrt(np.mean(tr.deflection[win] ** 2))),
+            "residual_tip_oscillation_m": _oscillation(tr, win),
             "residual_window_s": float(tr.t[win][-1] - tr.t[win][0]),
             "tip_rms_16_20_m": (float(np.sqrt(np.mean(tr.deflection[fixed] ** 2)))
                                 if fixed.any() else None),
@@ -147,6 +155,13 @@ def metrics(tr: Trace) -> dict:
             "peak_telescopic_force_N": (None if np.all(np.isnan(tr.force))
                                         else float(np.nanmax(np.abs(tr.force)))),
             "episode_return": tr.total_return}
+
+
+def _oscillation(tr: Trace, win: np.ndarray) -> float | None:
+    if tr.deflection_xz is None:
+        return None
+    d = tr.deflection_xz[win]
+    return float(np.sqrt(np.mean(np.sum((d - d.mean(axis=0)) ** 2, axis=1))))
 
 
 def mean_metrics(ms: list[dict]) -> dict:
@@ -279,7 +294,31 @@ def evaluate(model: str | list | None = None, episodes: int = 1, seed: int = 0,
     return results, traces
 
 
-def plot(traces: dict, path: str | os.PathLike) -> None:
+def save_traces(traces: dict, path) -> None:
+    """Write {name: Trace} to an npz file (atomically)."""
+    import io
+    from dataclasses import asdict
+
+    from sim_core.result import atomic_write_bytes
+    arrays = {f"{name}/{k}": np.asarray(v) for name, tr in traces.items()
+              for k, v in asdict(tr).items() if v is not None}
+    buf = io.BytesIO()
+    np.savez_compressed(buf, **arrays)
+    atomic_write_bytes(path, buf.getvalue())
+
+
+def load_traces(path) -> dict:
+    """{name: Trace} from a file of :func:`save_traces`."""
+    out: dict = {}
+    with np.load(path) as f:
+        for key in f.files:
+            name, field = key.rsplit("/", 1)
+            out.setdefault(name, {})[field] = f[key]
+    return {n: Trace(**{k: (float(v) if v.ndim == 0 else v) for k, v in d.items()})
+            for n, d in out.items()}
+
+
+def plot(traces: dict, path: str | os.PathLike, title: str | None = None) -> None:
     """Stroke, stroke rate and tip deflection vs time for every controller (one PNG)."""
     import matplotlib
     matplotlib.use("Agg")
@@ -298,7 +337,7 @@ def plot(traces: dict, path: str | os.PathLike) -> None:
     ax[0].legend(loc="lower right", fontsize=8)
     for a in ax:
         a.grid(alpha=0.3)
-    ax[0].set_title("Extraction 2 -> 8 m, 25 t, 60 deg (boom_env modal ROM)", fontsize=9)
+    ax[0].set_title(title or "Extraction 2 -> 8 m, 25 t, 60 deg (boom_env modal ROM)", fontsize=9)
     fig.tight_layout()
     save_figure(fig, path)
     plt.close(fig)
@@ -323,11 +362,22 @@ def main(argv=None) -> int:
                     help="env fidelity: rl (modal ROM, default) or paper (full model, slow)")
     ap.add_argument("--only", nargs="+", metavar="NAME",
                     help="evaluate only these controllers (e.g. cubic ppo)")
+    ap.add_argument("--traces", help="also save the first episode's traces (npz) here; "
+                                     "--plot-traces merges such files into one figure")
+    ap.add_argument("--plot-traces", nargs="+", metavar="NPZ",
+                    help="only plot saved traces (files of --traces) into --figure and exit")
+    ap.add_argument("--title", default=None, help="figure title")
     ap.add_argument("--json", action="store_true", help="print the metrics as one JSON object")
     ap.add_argument("--out", help="also write the JSON here")
     ap.add_argument("--figure", default="agents/results/evaluation.png",
                     help="figure path (default agents/results/evaluation.png); '' for none")
     args = ap.parse_args(argv)
+    if args.plot_traces:
+        traces = {}
+        for f in args.plot_traces:
+            traces.update(load_traces(f))
+        plot(traces, args.figure, args.title)
+        return 0
     if args.episodes < 1:
         ap.error(f"--episodes = {args.episodes}: allowed >= 1")
     for mp in args.model or []:
@@ -340,8 +390,10 @@ def main(argv=None) -> int:
     text = json.dumps(res, indent=2)
     if args.out:
         atomic_write_text(args.out, text + "\n")
+    if args.traces:
+        save_traces(traces, args.traces)
     if args.figure:
-        plot(traces, args.figure)
+        plot(traces, args.figure, args.title)
     if args.json:
         print(text)
     else:
