@@ -68,7 +68,7 @@ N_MODES_TABLE = 4
 # Table grid (SCENARIOS A4 stroke range 2 -> 8 m plus margin for the end stops of boom_env).
 L_GRID = np.linspace(1.75, 8.25, 11)       # avoids stroke_ref = 2 m (rope kink, see below)
 PAYLOADS = (20000.0, 25000.0, 30000.0)          # kg
-ANGLES = (60.0,)                                # deg (one angle: build time, see README)
+ANGLES = (45.0, 60.0, 75.0)                     # deg (the paper's 60 deg +- 15 deg)
 N_NODES = 3
 STROKE_REF = 2.0
 V_REF = 0.5                                     # m/s, for the velocity-dependent loads
@@ -158,15 +158,23 @@ def linearize_at(params, L_s, rope_L0: dict, z_guess=None, lam_guess=None):
             "all_freq_hz": np.sqrt(np.clip(w2[:12], 0, None)) / (2 * np.pi)}
 
 
+def reference_rope_lengths(p, stroke_ref=STROKE_REF) -> dict:
+    """Unstretched rope lengths (m) of the scene ``p`` (TelescopicParams): those of its static
+    equilibrium at piston length ``stroke_ref``, where the retraction rope is set just taut
+    (SCENARIOS A3).  The ropes keep them at every other piston length."""
+    from .telescopic import build_telescopic, initial_equilibrium
+    ref = build_telescopic(replace(p, stroke0=stroke_ref))
+    initial_equilibrium(ref)
+    return {k: r.L0 for k, r in _ropes(ref.model).items()}
+
+
 def build_config(payload, angle_deg, L_grid=L_GRID, stroke_ref=STROKE_REF, n_nodes=N_NODES,
                  base=None, log=print):
     """Tables of one (payload kg, angle deg) configuration: dict of arrays over L_grid."""
-    from .telescopic import TelescopicParams, build_telescopic, initial_equilibrium
+    from .telescopic import TelescopicParams
     p = replace(base or TelescopicParams(), payload=float(payload),
                 luffing_angle_deg=float(angle_deg), n_nodes=n_nodes, friction=False)
-    ref = build_telescopic(replace(p, stroke0=stroke_ref))
-    initial_equilibrium(ref)                      # sets the "just taut" retraction rope (A3)
-    rope_L0 = {k: r.L0 for k, r in _ropes(ref.model).items()}
+    rope_L0 = reference_rope_lengths(p, stroke_ref)
     order = np.argsort(np.abs(L_grid - stroke_ref))   # continuation outward from stroke_ref
     res = [None] * len(L_grid)
     for i in order:
@@ -217,26 +225,29 @@ def build_config(payload, angle_deg, L_grid=L_GRID, stroke_ref=STROKE_REF, n_nod
 
 def build_tables(path=DATA, payloads=PAYLOADS, angles=ANGLES, L_grid=L_GRID, log=print,
                  reuse=None):
-    """Build all configurations and write them to ``path`` (npz).  ``reuse``: an existing
-    tables file; configurations it holds on the same L_s grid are copied, not rebuilt."""
+    """Build all configurations and write them to ``path`` (npz).  ``reuse``: existing tables
+    file(s) (a path or a list of paths); configurations they hold on the same L_s grid are
+    copied, not rebuilt (this also merges tables built in separate processes, one per angle)."""
     t0 = time.perf_counter()
     data = {}
-    old = None
-    if reuse is not None and Path(reuse).exists():
-        with np.load(reuse) as f:
-            old = {k: f[k] for k in f.files}
-        if old["L_grid"].shape != np.shape(L_grid) or not np.allclose(old["L_grid"], L_grid):
-            old = None
+    olds = []
+    for src in ([] if reuse is None else [reuse] if isinstance(reuse, (str, Path)) else reuse):
+        if Path(src).exists():
+            with np.load(src) as f:
+                old = {k: f[k] for k in f.files}
+            if old["L_grid"].shape == np.shape(L_grid) and np.allclose(old["L_grid"], L_grid):
+                olds.append((src, old))
     for a in angles:
         for mp_ in payloads:
             cfg = None
-            if old is not None:
+            for src, old in olds:
                 ia = np.flatnonzero(np.isclose(old["angles"], a))
                 ip = np.flatnonzero(np.isclose(old["payloads"], mp_))
                 if len(ia) and len(ip):
                     cfg = {k: old[k][ia[0], ip[0]] for k in COLS + ("tip_static", "tip_dL",
                                                                      "freq_all_hz")}
-                    log(f"  m_p={mp_:g} kg theta={a:g} deg: reused from {reuse}")
+                    log(f"  m_p={mp_:g} kg theta={a:g} deg: reused from {src}")
+                    break
             if cfg is None:
                 cfg = build_config(mp_, a, L_grid, log=log)
             for k, v in cfg.items():
@@ -498,8 +509,9 @@ def main(argv=None):
                     help="luffing angles, deg (default: %(default)s)")
     ap.add_argument("--payloads", type=float, nargs="+", default=list(PAYLOADS),
                     help="payload masses, kg (default: %(default)s)")
-    ap.add_argument("--reuse", default=None,
-                    help="existing tables file whose configurations are copied, not rebuilt")
+    ap.add_argument("--reuse", nargs="+", default=None,
+                    help="existing tables file(s) whose configurations are copied, not rebuilt "
+                         "(also merges per-angle builds)")
     a = ap.parse_args(argv)
     if a.build:
         if a.quick:
