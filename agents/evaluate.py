@@ -22,7 +22,8 @@ Evaluation protocol (identical for every controller)
 * ``tip_rms_16_20_m``: RMS of |d| over the same fixed window for every controller, 16-20 s
   (the 4 s after the end of the paper's cubic schedule): controllers that keep moving after
   reaching the target (a policy damping the vibration actively) are then compared at the same
-  time, not each after its own stop.
+  time, not each after its own stop.  ``tip_oscillation_16_20_m``: the same window, deflection
+  vector about its mean (see ``residual_tip_oscillation_m``).
 * ``residual_tip_oscillation_m``: RMS of d - mean(d) (the deflection vector about its own mean)
   over the same window: the vibration alone.  It equals the residual RMS when the deflection
   reference is the model's own static tip (the modal ROM); with ``fidelity="paper"`` the
@@ -151,6 +152,7 @@ def metrics(tr: Trace) -> dict:
             "residual_window_s": float(tr.t[win][-1] - tr.t[win][0]),
             "tip_rms_16_20_m": (float(np.sqrt(np.mean(tr.deflection[fixed] ** 2)))
                                 if fixed.any() else None),
+            "tip_oscillation_16_20_m": _oscillation(tr, fixed) if fixed.any() else None,
             "peak_tip_deflection_m": float(tr.deflection.max()),
             "peak_telescopic_force_N": (None if np.all(np.isnan(tr.force))
                                         else float(np.nanmax(np.abs(tr.force)))),
