@@ -71,13 +71,17 @@ RESIDUAL_ENV_KWARGS = dict(tol_deflection=0.0)
 
 
 def _make_env(rank: int, seed: int, du_max: float | None, env_kwargs: dict,
-              random_start: float = 0.0, action_repeat: int = 1, residual: dict | None = None):
+              random_start: float = 0.0, action_repeat: int = 1, residual: dict | None = None,
+              obs_offset: float = 0.0):
     def thunk():
         import gymnasium as gym
         from stable_baselines3.common.monitor import Monitor
 
         import boom_env  # noqa: F401
         env = gym.make(ENV_ID, **env_kwargs)
+        if obs_offset > 0:
+            from .wrappers import DeflectionOffset
+            env = DeflectionOffset(env, obs_offset)
         if random_start > 0:
             from .wrappers import RandomStart
             env = RandomStart(env, random_start)
@@ -151,7 +155,8 @@ def train(timesteps: int, seed: int, out: str | os.PathLike, n_envs: int | None 
           du_max: float | None = None, env_kwargs: dict | None = None,
           random_start: float = 0.0, action_repeat: int = 1,
           residual: str | None = None, residual_scale: float = 0.25,
-          residual_omega: float = 1.0, residual_w_track: float = 1.0) -> Path:
+          residual_omega: float = 1.0, residual_w_track: float = 1.0,
+          obs_offset: float = 0.0) -> Path:
     """Train and save; returns the path of the saved model.  ``residual`` = a schedule name of
     ``agents.schedules`` makes the policy a residual on that schedule with tracking feedback
     (``agents.wrappers.ResidualOnSchedule``: scale, feedback frequency rad/s and the weight of
@@ -187,7 +192,7 @@ def train(timesteps: int, seed: int, out: str | os.PathLike, n_envs: int | None 
                              "at the task's start stroke; use random_start = 0")
         res = dict(schedule=residual, scale=float(residual_scale), omega=float(residual_omega),
                    w_track=float(residual_w_track))
-    fns = [_make_env(i, seed, du_max, env_kwargs, random_start, action_repeat, res)
+    fns = [_make_env(i, seed, du_max, env_kwargs, random_start, action_repeat, res, obs_offset)
            for i in range(n_envs)]
     venv = SubprocVecEnv(fns, start_method="spawn") if vec == "subproc" and n_envs > 1 else DummyVecEnv(fns)
     venv.seed(seed)
@@ -224,7 +229,7 @@ def train(timesteps: int, seed: int, out: str | os.PathLike, n_envs: int | None 
                                                "residual" if res else "acceleration"),
              "du_max": du_max, "action_repeat": action_repeat, "residual": res,
              "env_kwargs": env_kwargs,
-             "random_start": random_start,
+             "random_start": random_start, "obs_offset": obs_offset,
              "seed": seed, "timesteps": int(model.num_timesteps)}) + "\n")
         atomic_write_text(out / "train_info.txt",
                           f"timesteps {model.num_timesteps}\nseed {seed}\nn_envs {n_envs}\n"
@@ -268,6 +273,9 @@ def main(argv=None) -> int:
     ap.add_argument("--action-repeat", type=int, default=1,
                     help="hold each policy action for K env steps (agents.wrappers.ActionRepeat; "
                          "control period K x 0.05 s; default 1)")
+    ap.add_argument("--obs-offset", type=float, default=0.0,
+                    help="random constant offset (m) of the observed tip deflection per "
+                         "episode (agents.wrappers.DeflectionOffset; default 0 = off)")
     ap.add_argument("--env-set", action="append", default=[], metavar="KEY=VALUE",
                     help="training-env constructor argument (replaces the defaults "
                          f"{TRAIN_ENV_KWARGS}); repeatable")
@@ -301,7 +309,7 @@ def main(argv=None) -> int:
                                else 0.0 if args.residual else 0.5),
                  action_repeat=args.action_repeat, residual=args.residual,
                  residual_scale=args.residual_scale, residual_omega=args.residual_omega,
-                 residual_w_track=args.residual_track_weight)
+                 residual_w_track=args.residual_track_weight, obs_offset=args.obs_offset)
     print(f"saved {path}")
     return 0
 

@@ -287,3 +287,28 @@ def test_traces_round_trip_and_oscillation_metric(tmp_path):
     assert m2["residual_tip_rms_m"] > 2 * m["residual_tip_rms_m"]
     # the vibration after the cubic's stop is a free oscillation about ~0: both metrics agree
     assert m["residual_tip_oscillation_m"] == pytest.approx(m["residual_tip_rms_m"], rel=0.05)
+
+
+def test_deflection_offset_shifts_only_the_observed_deflection():
+    """DeflectionOffset adds one constant (per episode, within +-max_offset, seeded) to the
+    observed dX, dZ; the other observations and the reward are the env's."""
+    import gymnasium as gym
+
+    import boom_env  # noqa: F401
+    from agents.wrappers import DeflectionOffset
+    plain = gym.make("boom_env/TelescopicExtraction-v0")
+    wrapped = DeflectionOffset(gym.make("boom_env/TelescopicExtraction-v0"), 5e-3)
+    o0, _ = plain.reset(seed=4)
+    o1, _ = wrapped.reset(seed=4)
+    off = o1[5:7] - o0[5:7]
+    assert np.all(np.abs(off) <= 5e-3) and np.any(np.abs(off) > 0)
+    for _ in range(20):
+        a = np.array([0.6], np.float32)
+        (o0, r0, *_), (o1, r1, *_) = plain.step(a), wrapped.step(a)
+        np.testing.assert_allclose(o1[5:7] - o0[5:7], off, atol=1e-9)
+        np.testing.assert_array_equal(np.delete(o1, [5, 6]), np.delete(o0, [5, 6]))
+        assert r1 == r0
+    o2, _ = wrapped.reset(seed=4)
+    np.testing.assert_allclose(o2[5:7] - plain.reset(seed=4)[0][5:7], off, atol=1e-9)
+    with pytest.raises(ValueError, match="max_offset"):
+        DeflectionOffset(plain, -1.0)
