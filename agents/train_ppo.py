@@ -273,9 +273,10 @@ def main(argv=None) -> int:
     ap.add_argument("--action-repeat", type=int, default=1,
                     help="hold each policy action for K env steps (agents.wrappers.ActionRepeat; "
                          "control period K x 0.05 s; default 1)")
-    ap.add_argument("--obs-offset", type=float, default=0.0,
+    ap.add_argument("--obs-offset", type=float, default=None,
                     help="random constant offset (m) of the observed tip deflection per "
-                         "episode (agents.wrappers.DeflectionOffset; default 0 = off)")
+                         "episode (agents.wrappers.DeflectionOffset; default 0.005 with "
+                         "--residual, else 0)")
     ap.add_argument("--env-set", action="append", default=[], metavar="KEY=VALUE",
                     help="training-env constructor argument (replaces the defaults "
                          f"{TRAIN_ENV_KWARGS}); repeatable")
@@ -309,7 +310,9 @@ def main(argv=None) -> int:
                                else 0.0 if args.residual else 0.5),
                  action_repeat=args.action_repeat, residual=args.residual,
                  residual_scale=args.residual_scale, residual_omega=args.residual_omega,
-                 residual_w_track=args.residual_track_weight, obs_offset=args.obs_offset)
+                 residual_w_track=args.residual_track_weight,
+                 obs_offset=(args.obs_offset if args.obs_offset is not None
+                             else 0.005 if args.residual else 0.0))
     print(f"saved {path}")
     return 0
 
