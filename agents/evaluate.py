@@ -214,10 +214,8 @@ class PPOPolicy:
         if self.residual:
             from .schedules import by_name
             from .wrappers import ScheduleTracker
-            u = env.unwrapped
-            self.tracker = ScheduleTracker(by_name(self.residual["schedule"]), u.dt, u.a_max,
-                                           int(round(u.t_max / u.dt)), self.residual["scale"],
-                                           self.residual["omega"])
+            self.tracker = ScheduleTracker.for_env(by_name(self.residual["schedule"]), env,
+                                                   self.residual["scale"], self.residual["omega"])
 
     def __call__(self, obs: np.ndarray, k: int) -> float:
         if self.tracker is not None:       # agents.wrappers.ResidualOnSchedule

@@ -130,6 +130,12 @@ class ScheduleTracker:
         self.dL_ref = np.concatenate([[0.0], np.cumsum(0.5 * dt * (self.v_ref[1:] + self.v_ref[:-1]))])
         self.L0 = 0.0
 
+    @classmethod
+    def for_env(cls, schedule, env: gym.Env, scale: float = 0.25, omega: float = 1.0):
+        """The tracker for ``env``'s control step, a_max and episode length."""
+        u = env.unwrapped
+        return cls(schedule, u.dt, u.a_max, int(round(u.t_max / u.dt)), scale, omega)
+
     def reset(self, stroke: float) -> None:
         """Anchor the stroke reference at the episode's start piston length (m)."""
         self.L0 = float(stroke)
@@ -170,12 +176,10 @@ class ResidualOnSchedule(gym.Wrapper):
         if not w_track >= 0:
             raise ValueError(f"w_track = {w_track!r}: allowed >= 0")
         self.w_track = float(w_track)
-        u = env.unwrapped
         if schedule is None:
             from .schedules import cubic
             schedule = cubic()
-        n_steps = int(round(u.t_max / u.dt))
-        self.tracker = ScheduleTracker(schedule, u.dt, u.a_max, n_steps, scale, omega)
+        self.tracker = ScheduleTracker.for_env(schedule, env, scale, omega)
         lo, hi = env.observation_space.low, env.observation_space.high
         span = float(hi[0] - lo[0])
         vm = float(hi[1])

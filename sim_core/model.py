@@ -176,8 +176,8 @@ class Model:
             # P selects (and signs) coordinates, the usual case of boundary conditions that fix
             # single coordinates: P^T M P is a sub-matrix (two dense products of the N x N mass
             # matrix were ~1/4 of a telescopic right-hand side at 8 sub-elements)
-            rows, sgn = self._sel
-            return M[np.ix_(rows, rows)] * np.outer(sgn, sgn), sgn * (F - M @ Qdd_p)[rows]
+            rows, sgn, sgn2 = self._sel
+            return M[np.ix_(rows, rows)] * sgn2, sgn * (F - M @ Qdd_p)[rows]
         Mr = self.P.T @ M @ self.P
         Fr = self.P.T @ (F - M @ Qdd_p)
         return Mr, Fr
@@ -398,12 +398,14 @@ def fix_material_coordinate(model_offsets, beams: list[Beam], ibeam: int, breakp
 
 
 def _selection(P: np.ndarray):
-    """(rows, values) if every column of P has exactly one non-zero entry, in distinct rows
-    (then P^T X P = X[rows][:, rows] * outer(values, values)); else None."""
+    """(rows, values, outer(values, values)) if every column of P has exactly one non-zero
+    entry, in distinct rows (then P^T X P = X[rows][:, rows] * outer(values, values)); else
+    None.  The outer product is kept so the right-hand side does not rebuild it."""
     nz = P != 0.0
     if P.size == 0 or not np.all(nz.sum(axis=0) == 1):
         return None
     rows = np.argmax(nz, axis=0)
     if len(np.unique(rows)) != len(rows):
         return None
-    return rows, P[rows, np.arange(P.shape[1])].copy()
+    vals = P[rows, np.arange(P.shape[1])].copy()
+    return rows, vals, np.outer(vals, vals)

@@ -62,7 +62,7 @@ def test_selection_fast_path_equals_the_dense_projection():
     np.testing.assert_array_equal(Fr, Fr0)
     P = np.zeros((3, 2))
     P[0, 0], P[2, 1] = 1.0, -1.0
-    rows, vals = _selection(P)
+    rows, vals, _ = _selection(P)
     assert list(rows) == [0, 2] and list(vals) == [1.0, -1.0]
     P[1, 1] = 0.5                                  # column 1 mixes two coordinates
     assert _selection(P) is None
