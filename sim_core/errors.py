@@ -34,3 +34,23 @@ class SimulationError(RuntimeError):
         if step is not None:
             msg += f" (step {step:.3g} s)"
         super().__init__(msg)
+
+
+class NoStaticEquilibrium(SimulationError):
+    """The static equilibrium does not exist at the full load: the equilibrium path in the load
+    factor (the weight scaled by lambda) turns back at a limit point (fold) below 1.
+
+    Attributes
+    ----------
+    load_factor_max : float
+        Largest load factor on the traced equilibrium path (the limit load / the full load).
+    path : list[tuple[float, float]]
+        (load factor, scaled displacement from the unloaded state) of the traced points.
+    """
+
+    def __init__(self, t: float, load_factor_max: float, path, reason: str | None = None):
+        self.load_factor_max = float(load_factor_max)
+        self.path = list(path)
+        super().__init__(t, reason or (
+            "no static equilibrium: the equilibrium path under the weight turns back at a limit "
+            f"point at {self.load_factor_max:.3g} x the full weight (load continuation)"))

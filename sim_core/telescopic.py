@@ -280,7 +280,32 @@ def initial_equilibrium(ts: TelescopicSystem, t: float = 0.0):
     of either sign: the pair of opposing ropes acts as one rope), and afterwards the rope that
     carries the load is given that tension and the other one is made just taut at the start of
     its stiff branch (tension (EA/L0) slack_width / 2, ~5 N at the paper's EA); a final
-    tension-only Newton from there leaves both ropes taut and the equilibrium well posed."""
+    tension-only Newton from there leaves both ropes taut and the equilibrium well posed.
+
+    Where Newton does not converge, the statics trace the equilibrium under the weight by load
+    continuation (:func:`sim_core.statics.load_continuation`).  At low luffing angles the
+    paper's luffing geometry has a short cylinder lever (0.23 m at 0 deg), and soft booms
+    (E = 2.1e10 Pa) at 0 deg reach a limit point at 0.29 x their own weight: then
+    :class:`~sim_core.errors.NoStaticEquilibrium` is raised, naming the angle and the lever."""
+    from .errors import NoStaticEquilibrium
+    try:
+        return _initial_equilibrium(ts, t)
+    except NoStaticEquilibrium as exc:
+        # the statics' load continuation found a limit point below the full weight: say why
+        import math
+        from .validation.closed_form import luffing_geometry
+        p = ts.params
+        lever = luffing_geometry(math.radians(p.luffing_angle_deg)).lever
+        raise NoStaticEquilibrium(exc.t, exc.load_factor_max, exc.path, reason=(
+            f"no static equilibrium at luffing angle {p.luffing_angle_deg:g} deg (E = {p.E:.3g} "
+            f"Pa, payload {p.payload:g} kg): the equilibrium path under the weight turns back at "
+            f"a limit point at {exc.load_factor_max:.3g} x the full weight.  The luffing "
+            f"cylinder's lever about the pivot D1 is {lever:.3f} m at this angle (0.714 m at "
+            "60 deg) and the booms' deflection shortens it further; the limit load scales with "
+            "E (README, 'The telescopic boom system')")) from exc
+
+
+def _initial_equilibrium(ts: TelescopicSystem, t: float):
     from .statics import constrained_static_equilibrium
     m = ts.model
     z0, _ = m.reduced_state(t, ts.Q0, np.zeros_like(ts.Q0))
