@@ -480,7 +480,7 @@ def scaled_static_equilibrium(m: Model, z0: np.ndarray, t: float = 0.0, k_ref: f
     Forward-difference tangent.  Converged when |r| < tol * (total weight scale) and
     |Phi| < 1e-10.  Returns (z, lambda)."""
     from .errors import SimulationError
-    from .statics import static_parts
+    from .statics import _force_tangent, static_parts
     z = np.array(z0, float)
     n = len(z)
     parts = static_parts(m, t)
@@ -494,13 +494,7 @@ def scaled_static_equilibrium(m: Model, z0: np.ndarray, t: float = 0.0, k_ref: f
         r1 = Fr + C.T @ lam
         if np.linalg.norm(r1) <= tol * scale and np.max(np.abs(phi), initial=0.0) < 1e-10:
             return z, lam
-        h = 1e-7 * max(1.0, float(np.max(np.abs(z))))
-        K = np.empty((n, n))
-        for j in range(n):
-            zj = z.copy()
-            zj[j] += h
-            Fj, _, Cj = parts(zj)
-            K[:, j] = ((Fj + Cj.T @ lam) - r1) / h
+        K = _force_tangent(parts, z, lam, rel_step=1e-7, r0=r1)       # forward differences
         A = np.block([[K, C.T], [C, np.zeros((mm, mm))]])
         d = S * np.linalg.solve(S[:, None] * A * S[None, :], -S * np.concatenate([r1, phi]))
         z, lam = z + d[:n], lam + d[n:]

@@ -85,20 +85,26 @@ def static_parts(model: Model, t: float = 0.0):
     return parts
 
 
-def _force_tangent(parts, z: np.ndarray, lam: np.ndarray) -> np.ndarray:
-    """d(P^T F + C^T lambda)/dz at fixed lambda by central differences (N/m, N/rad).
+def _force_tangent(parts, z: np.ndarray, lam: np.ndarray, rel_step: float = 1e-6,
+                   r0: np.ndarray | None = None) -> np.ndarray:
+    """d(P^T F + C^T lambda)/dz at fixed lambda by finite differences (N/m, N/rad), step
+    rel_step * max(1, |z|_inf): central differences, or forward ones from the residual ``r0``
+    at z when it is given (half the model evaluations; the folding boom's statics use them).
 
     Central differences: the Newton system of stiff booms is dominated by cancellation (entries
     EA/l ~ 1e13 N/m against residuals ~ 1e5 N), and the O(h) truncation error of forward
     differences (~1e-6 relative) made the Newton step useless at 8 sub-elements
     (benchmarks/diagnose_static_tangent.py); the O(h^2) error of central ones does not."""
     n = len(z)
-    h = 1e-6 * max(1.0, float(np.max(np.abs(z))))
+    h = rel_step * max(1.0, float(np.max(np.abs(z))))
     K = np.empty((n, n))
     for j in range(n):
         zj = z.copy()
         zj[j] += h
         Fp, _, Cp = parts(zj)
+        if r0 is not None:
+            K[:, j] = ((Fp + Cp.T @ lam) - r0) / h
+            continue
         zj[j] -= 2 * h
         Fm, _, Cm = parts(zj)
         K[:, j] = ((Fp + Cp.T @ lam) - (Fm + Cm.T @ lam)) / (2 * h)
@@ -330,8 +336,7 @@ def load_continuation(model: Model, z0: np.ndarray, t: float = 0.0, tol: float =
                 r_prev = rn
                 with gravity_scaled(model, li):          # full Newton: tangent at the iterate
                     Ki = _force_tangent(parts, zi, mui)
-                Fli = Fi - at(0.0, zi)[0] if li != 0.0 else Fl
-                Fli = Fli / li if li != 0.0 else Fl
+                Fli = at(1.0, zi)[0] - at(0.0, zi)[0]     # dR/dlam_g at the iterate
                 try:
                     d = np.linalg.solve(bordered(Ki, Fli, Ci, a_z, c),
                                         -np.concatenate([Ri, phii, [0.0]]))
