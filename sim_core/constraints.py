@@ -50,7 +50,11 @@ _H = 1e-20
 
 
 def constraint_terms(cons: list[NonlinearConstraint], t: float, Q: Vec, Qd: Vec):
-    """Stacked (violation Phi, Jacobian g_Q, velocity violation Phi_dot, b_ddot - g_QQ[Qd,Qd])."""
+    """Stacked (violation Phi, Jacobian g_Q, velocity violation Phi_dot, b_ddot - g_QQ[Qd,Qd]);
+    empty rows (and a 0 x N Jacobian) without constraints."""
+    if not cons:
+        e = np.zeros(0)
+        return e, np.zeros((0, len(Q))), e, e
     phis, jacs, dphis, rhs = [], [], [], []
     Qc = Q + 1j * _H * Qd                  # one complex state: the point caches serve all rows
     for c in cons:

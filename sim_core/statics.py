@@ -78,8 +78,6 @@ def static_parts(model: Model, t: float = 0.0):
     def parts(zz):
         Q, _ = model.full_state(t, zz, np.zeros_like(zz))
         _, F = model.mass_force(t, Q, np.zeros_like(Q), mass=False)
-        if not model.nonlinear:                    # no nonlinear constraints: empty rows
-            return model.P.T @ F, np.zeros(0), np.zeros((0, len(zz)))
         phi, J, _, _ = constraint_terms(model.nonlinear, t, Q, np.zeros_like(Q))
         return model.P.T @ F, phi, J @ model.P
     return parts
@@ -211,10 +209,11 @@ def gravity_scaled(model: Model, factor: float):
 class EquilibriumPath:
     """Points of a traced equilibrium path: load factor (weight / full weight), scaled
     displacement |z - z_unloaded| / |dz/dlambda at 0| (1 = the linear response to the full
-    weight) and the load-factor component of the unit path tangent (changes sign at a limit
-    point)."""
+    weight), arclength of the continuation (predictor step lengths summed, same scaled metric)
+    and the load-factor component of the unit path tangent (changes sign at a limit point)."""
 
     load_factor: list[float] = field(default_factory=list)
+    arclength: list[float] = field(default_factory=list)
     displacement: list[float] = field(default_factory=list)
     tangent_load: list[float] = field(default_factory=list)
 
@@ -265,7 +264,7 @@ def load_continuation(model: Model, z0: np.ndarray, t: float = 0.0, tol: float =
     prev_dir = None
     prev = None                    # previous converged point and the step length to it
     ds = ds0
-    s_acc = [0.0]
+    s = 0.0                        # arclength of the current point
     with gravity_scaled(model, lg):
         K = _force_tangent(parts, z, mu)
 
@@ -298,11 +297,12 @@ def load_continuation(model: Model, z0: np.ndarray, t: float = 0.0, tol: float =
         if prev_dir is not None and direction @ prev_dir < 0:
             c, direction = -c, -direction
         path.load_factor.append(lg)
+        path.arclength.append(s)
         path.displacement.append(float(np.linalg.norm(z - z_un) / z_ref))
         path.tangent_load.append(float(c))
         if prev_dir is not None and c < 0:                       # the path turned back
             lams = np.array(path.load_factor[-3:])
-            ss = np.array(s_acc[-3:])
+            ss = np.array(path.arclength[-3:])
             lam_max = float(np.max(path.load_factor))
             if len(lams) == 3:
                 a2, a1, a0 = np.polyfit(ss - ss[1], lams, 2)
@@ -349,7 +349,6 @@ def load_continuation(model: Model, z0: np.ndarray, t: float = 0.0, tol: float =
             if ds < 1e-4:
                 raise SimulationError(t, "load continuation: step length below 1e-4 at "
                                          f"{lg:.3g} x weight (corrector does not converge)")
-        s_acc.append(s_acc[-1] + ds)
         if li >= target:
             # the target lies between the last two points: Newton at exactly lam_g = target
             w = (target - lg) / (li - lg)
@@ -357,11 +356,12 @@ def load_continuation(model: Model, z0: np.ndarray, t: float = 0.0, tol: float =
                 zt, mt = constrained_static_equilibrium(model, z + w * (zi - z), t, tol=tol,
                                                         continuation=False)
             path.load_factor.append(target)
+            path.arclength.append(s + w * ds)
             path.displacement.append(float(np.linalg.norm(zt - z_un) / z_ref))
             path.tangent_load.append(float("nan"))
             return zt, mt
         prev = (z, mu, lg, ds)
-        z, mu, lg = zi, mui, li
+        z, mu, lg, s = zi, mui, li, s + ds
         # the last corrector tangent stands for the one at the converged point (one quadratically
         # convergent Newton step away)
         K = Ki
