@@ -38,6 +38,14 @@ class NonlinearConstraint:
     m: int
     evaluate: Callable[[Vec], tuple[Vec, Vec]]
     target: Callable[[float], tuple[Vec, Vec, Vec]] | None = None
+    # the point functions g is built from; they say which coordinates g depends on, so the
+    # structured Jacobian (sim_core.state_jacobian) differentiates only those. None: unknown
+    # (every coordinate is differenced)
+    points: tuple | None = None
+
+    def coords(self, Q: Vec) -> np.ndarray | None:
+        """Coordinates g depends on at Q (None: possibly all)."""
+        return None if self.points is None else dependencies(self.points, Q)
 
     def b(self, t: float):
         if self.target is None:
@@ -47,6 +55,18 @@ class NonlinearConstraint:
 
 
 _H = 1e-20
+
+
+def dependencies(points, Q: Vec) -> np.ndarray | None:
+    """Union of the coordinates the point functions depend on at Q; None if one of them does not
+    say (a point function may carry ``coords(Q)``, as :func:`material_point`'s do)."""
+    sets = []
+    for p in points:
+        c = getattr(p, "coords", None)
+        if c is None:
+            return None
+        sets.append(np.asarray(c(Q), dtype=int))
+    return np.unique(np.concatenate(sets)) if sets else np.zeros(0, dtype=int)
 
 
 def constraint_terms(cons: list[NonlinearConstraint], t: float, Q: Vec, Qd: Vec):
@@ -117,14 +137,19 @@ def material_point(model, ibeam: int, s_fixed: float | None = None, s_index: int
     off = int(model.offsets[ibeam])
     N = model.n_coords
 
-    memo: list = []                        # [(Q copy, result)] for the real and complex state
+    # [(coordinates, their values, result)] for the last real and the last complex state; keyed
+    # on the coordinates the point depends on, so a state that differs elsewhere (another
+    # body's coordinate perturbed for a Jacobian column) reuses the evaluation
+    memo: list = []
 
     def f(Q):
-        for Qm, res in memo:
-            if Qm.dtype == Q.dtype and Qm.shape == Q.shape and np.array_equal(Qm, Q):
+        cols = coords(Q)
+        vals = Q[cols]
+        for c, v, res in memo:
+            if v.dtype == vals.dtype and np.array_equal(c, cols) and np.array_equal(v, vals):
                 return res
         res = _evaluate(Q)
-        memo[:] = [m for m in memo if m[0].dtype != Q.dtype][:1] + [(Q.copy(), res)]
+        memo[:] = [m for m in memo if m[1].dtype != vals.dtype][:1] + [(cols, vals, res)]
         return res
 
     def _evaluate(Q):
@@ -152,7 +177,25 @@ def material_point(model, ibeam: int, s_fixed: float | None = None, s_index: int
             r = r + o
         return r, J, kin.sec.angles[0], Jp
 
+    def coords(Q):
+        """The coordinates r and Psi depend on at Q: the element's, and s_index if moving."""
+        s = np.real(Q[s_index]) if s_index is not None else s_fixed
+        idx = off + beam.index_map[model._element_at(ibeam, np.real(Q), float(s))]
+        return idx if s_index is None else np.append(idx, s_index)
+
+    f.coords = coords
     cache[key] = f
+    return f
+
+
+def fixed_point(r) -> Callable:
+    """A point fixed in space (m): the point-function signature with zero Jacobians."""
+    r = np.asarray(r, float)
+
+    def f(Q):
+        Z = np.zeros((3, len(Q)))
+        return r, Z, np.zeros(3), Z
+    f.coords = lambda Q: np.zeros(0, dtype=int)
     return f
 
 
@@ -172,7 +215,8 @@ def _coincidence(name: str, fa, fb, fixed, part: int) -> NonlinearConstraint:
             return a[2 * part], a[2 * part + 1]
         b = fb(Q)
         return a[2 * part] - b[2 * part], a[2 * part + 1] - b[2 * part + 1]
-    return NonlinearConstraint(name, 3, evaluate, None if fixed is None else _fixed(fixed))
+    return NonlinearConstraint(name, 3, evaluate, None if fixed is None else _fixed(fixed),
+                               points=(fa,) if fb is None else (fa, fb))
 
 
 def point_coincidence(name: str, fa, fb=None, fixed=None) -> NonlinearConstraint:
@@ -196,7 +240,7 @@ def distance_driver(name: str, fa, fb, length) -> NonlinearConstraint:
         d = ra - rb
         n = np.sqrt(d @ d)
         return np.atleast_1d(n), ((d / n) @ (Ja - Jb))[None, :]
-    return NonlinearConstraint(name, 1, evaluate, length)
+    return NonlinearConstraint(name, 1, evaluate, length, points=(fa, fb))
 
 
 def rope_length(name: str, points, length: float) -> NonlinearConstraint:
@@ -216,4 +260,4 @@ def rope_length(name: str, points, length: float) -> NonlinearConstraint:
             ell = ell + n
             J = J + (d / n) @ (Jb - Ja)
         return np.atleast_1d(ell), np.atleast_2d(J)
-    return NonlinearConstraint(name, 1, evaluate, _fixed([length]))
+    return NonlinearConstraint(name, 1, evaluate, _fixed([length]), points=tuple(points))

@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from .beam.cardan import cardan_frame
+from .constraints import dependencies
 from .contact import FrictionLaw, SliderGeometry, SpringLaw, solve_micro_motion
 
 
@@ -69,6 +70,15 @@ class ContactFriction:
             self.regions.append((f"I_{k + 1}{k + 2}", inner, ts.s2_index[k], geo[0]))
             self.regions.append((f"II_{k + 1}{k + 2}", outer, ts.s3_index[k + 1], geo[1]))
         self._x0 = {}
+
+    def coords(self, Q):
+        """Coordinates the friction forces depend on besides the multipliers: the contact
+        points' elements and contact coordinates (their velocities enter the law)."""
+        return dependencies([point for _, point, _, _ in self.regions], Q)
+
+    def velocity_coords(self, Q):
+        """Rates in the friction law: the contact coordinates' (s_dot of Eq. 65)."""
+        return np.array([s_idx for _, _, s_idx, _ in self.regions], dtype=int)
 
     def solve_regions(self, Q, Qd, lam):
         """Per region: (name, s_index, mu, ContactSolution) (distribution on) or

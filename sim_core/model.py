@@ -109,24 +109,38 @@ class Model:
     # -- assembly --------------------------------------------------------------------------
     def element_contexts(self, t: float, Q: np.ndarray, Qd: np.ndarray):
         """Yield (global indices, ElementContext) for every element; kinematics computed once."""
-        strains = "strains" in self.needs
-        mat = "material_strain" in self.needs
-        conv = "convective" in self.needs
         for b, off in zip(self.beams, self.offsets):
             for el, imap in zip(b.elements, b.index_map):
                 idx = off + imap
-                qe, qde = Q[idx], Qd[idx]
-                kin = el.evaluate(qe, strains=strains, material_strain=mat)
-                ctx = ElementContext(t, el, qe, qde, kin, el.q_w * kin.ell)
-                if conv:
-                    kc = el.evaluate(qe + 1j * _CSTEP * qde, s=kin.s, sub=kin.sub,
-                                     strains=mat, material_strain=mat)
-                    c = {"a": np.einsum("gin,n->gi", kc.J_r, qde).imag / _CSTEP,
-                         "w_dot": np.einsum("gin,n->gi", kc.J_w, qde).imag / _CSTEP}
-                    if mat:
-                        c["eps_ddot"] = np.einsum("gin,n->gi", kc.B_s, qde).imag / _CSTEP
-                    ctx.conv = c
-                yield idx, ctx
+                yield idx, self.element_context(t, el, Q[idx], Qd[idx])
+
+    def element_context(self, t: float, el, qe: np.ndarray, qde: np.ndarray,
+                        kin=None) -> ElementContext:
+        """Kinematics of one element with the quantities the effects declare in ``needs``
+        (``kin``: the position-level kinematics at qe, if already at hand)."""
+        strains = "strains" in self.needs
+        mat = "material_strain" in self.needs
+        if kin is None:
+            kin = el.evaluate(qe, strains=strains, material_strain=mat)
+        ctx = ElementContext(t, el, qe, qde, kin, el.q_w * kin.ell)
+        if "convective" in self.needs:
+            kc = el.evaluate(qe + 1j * _CSTEP * qde, s=kin.s, sub=kin.sub,
+                             strains=mat, material_strain=mat)
+            c = {"a": np.einsum("gin,n->gi", kc.J_r, qde).imag / _CSTEP,
+                 "w_dot": np.einsum("gin,n->gi", kc.J_w, qde).imag / _CSTEP}
+            if mat:
+                c["eps_ddot"] = np.einsum("gin,n->gi", kc.B_s, qde).imag / _CSTEP
+            ctx.conv = c
+        return ctx
+
+    def element_mass_force(self, ctx: ElementContext, mass: bool = True):
+        """Element mass matrix (or None) and force vector from the model's effects."""
+        ne = len(ctx.qe)
+        Me = np.zeros((ne, ne)) if mass else None
+        Fe = np.zeros(ne)
+        for eff in self.effects:
+            eff.element_terms(ctx, Me, Fe)
+        return Me, Fe
 
     def mass_force(self, t: float, Q: np.ndarray, Qd: np.ndarray, mass: bool = True):
         """Full-coordinate mass matrix (or None) and force vector: M Q_ddot = F."""
@@ -134,11 +148,7 @@ class Model:
         M = np.zeros((N, N)) if mass else None
         F = np.zeros(N)
         for idx, ctx in self.element_contexts(t, Q, Qd):
-            ne = len(idx)
-            Me = np.zeros((ne, ne)) if mass else None
-            Fe = np.zeros(ne)
-            for eff in self.effects:
-                eff.element_terms(ctx, Me, Fe)
+            Me, Fe = self.element_mass_force(ctx, mass)
             if mass:
                 M[np.ix_(idx, idx)] += Me
             np.add.at(F, idx, Fe)

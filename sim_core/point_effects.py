@@ -12,6 +12,8 @@ from typing import Callable, Sequence
 
 import numpy as np
 
+from .constraints import dependencies
+
 _H = 1e-20
 
 
@@ -24,6 +26,14 @@ class PointMass:
     mass: float
     gravity: np.ndarray | None = None
     name: str = "payload"
+
+    def coords(self, Q):
+        """Coordinates the payload's force and mass depend on (None: possibly all)."""
+        return dependencies((self.point,), Q)
+
+    def velocity_coords(self, Q):
+        """Coordinates whose rates enter the force (the point's: the convective term)."""
+        return self.coords(Q)
 
     def add(self, t, Q, Qd, M, F):
         _, J, _, _ = self.point(Q)
@@ -51,6 +61,14 @@ class RopeDrive:
     name: str = "rope"
     bilateral: bool = False     # statics only: T = (EA/L0)(l - L0) of either sign (see
                                 # telescopic.initial_equilibrium); never in dynamics
+
+    def coords(self, Q):
+        """Coordinates the rope force depends on (None: possibly all)."""
+        return dependencies(self.points, Q)
+
+    def velocity_coords(self, Q):
+        """The rope force does not depend on rates."""
+        return np.zeros(0, dtype=int)
 
     def length(self, Q):
         pts = [p(Q) for p in self.points]

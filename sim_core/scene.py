@@ -227,18 +227,22 @@ def choice(table: dict, key: str, where: str, allowed: tuple[str, ...], default=
 
 # -- the solver table (all scene kinds) ----------------------------------------------------------
 
-_SOLVER = {"t_end", "method", "rtol", "atol", "n_output", "max_step", "max_wall_s"}
+_SOLVER = {"t_end", "method", "jacobian", "rtol", "atol", "n_output", "max_step", "max_wall_s"}
 SOLVER_METHODS = ("RK45", "BDF", "auto")
+JACOBIANS = ("structured", "finite_difference")
 
 
 def solver_table(s: dict, t_end=None, atol: float = 1e-8, n_output: int = 201) -> dict:
     """The validated [solver] table shared by every scene kind: t_end s (> 0), method
-    (``SOLVER_METHODS``, see :func:`sim_core.simulate.integrate`), rtol (0, 1), atol (> 0),
+    (``SOLVER_METHODS``, see :func:`sim_core.simulate.integrate`), jacobian of the implicit
+    method (``JACOBIANS``: "structured" = :mod:`sim_core.state_jacobian`, "finite_difference" =
+    scipy's differences of the whole right-hand side), rtol (0, 1), atol (> 0),
     n_output (>= 2), optional max_step s (> 0) and max_wall_s s (> 0, wall-clock budget).
     The arguments are the scene kind's defaults (t_end None: required)."""
     check_keys(s, _SOLVER, "solver")
     out = {"t_end": number(s, "t_end", "solver", t_end, lo=0.0, lo_open=True),
            "method": choice(s, "method", "solver", SOLVER_METHODS, "RK45"),
+           "jacobian": choice(s, "jacobian", "solver", JACOBIANS, "structured"),
            "rtol": number(s, "rtol", "solver", 1e-6, lo=0.0, hi=1.0, lo_open=True, hi_open=True),
            "atol": number(s, "atol", "solver", atol, lo=0.0, lo_open=True),
            "n_output": number(s, "n_output", "solver", n_output, lo=2, integer=True)}

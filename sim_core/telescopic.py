@@ -31,8 +31,8 @@ import numpy as np
 
 from .assemble import reference_basis
 from .beam.moving_node_beam import Beam, BeamSection
-from .constraints import (NonlinearConstraint, angle_coincidence, distance_driver, material_point,
-                          point_coincidence, rope_length)
+from .constraints import (NonlinearConstraint, angle_coincidence, distance_driver, fixed_point,
+                          material_point, point_coincidence, rope_length)
 from .drive_profiles import CubicSmoothstepSchedule
 from .effects import Effect, Elasticity, Gravity, Inertia, StressFilter
 from .model import Model, boundary_condition, fix_material_coordinate
@@ -148,14 +148,6 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
     def mp(k, **kw):
         return material_point(model, k, **kw)
 
-    def fixed_point(r):
-        r = np.asarray(r, float)
-
-        def f(Q):
-            Z = np.zeros((3, len(Q)))
-            return r, Z, np.zeros(3), Z
-        return f
-
     cons: list[NonlinearConstraint] = []
     names: list[tuple[str, int]] = []
 
@@ -263,7 +255,8 @@ def _rows(c: NonlinearConstraint, keep: list[int]) -> NonlinearConstraint:
     def target(t):
         b, bd, bdd = tgt(t)
         return b[keep], bd[keep], bdd[keep]
-    return NonlinearConstraint(c.name, len(keep), evaluate, None if tgt is None else target)
+    return NonlinearConstraint(c.name, len(keep), evaluate, None if tgt is None else target,
+                               points=c.points)
 
 
 def initial_equilibrium(ts: TelescopicSystem, t: float = 0.0):

@@ -1,0 +1,248 @@
+"""Jacobian of the state equations by implicit differentiation and local finite differences.
+
+The integrated system is y = (z, z_dot), y' = (z_dot, z_ddot(t, z, z_dot)), where z_ddot and the
+constraint multipliers lambda solve the index-1 saddle-point system of :class:`sim_core.model.
+Model` (constraint rows g(Q) = b(t), Baumgarte terms xi1, xi2; second seed Eq. 8), with the
+multiplier-dependent friction forces of Zhao-Qi-Wang 2024 Section 8.3 in the force vector:
+
+    R1 = P^T [ F(Q, Q_dot) + F_mu(Q, Q_dot, lambda) - M(Q) Q_ddot + G(Q)^T lambda ] = 0
+    R2 = G(Q) Q_ddot - (b_ddot - g_QQ[Q_dot, Q_dot] - 2 xi1 Phi_dot - xi2^2 Phi)     = 0
+
+with Q = Q_p(t) + P z, Q_ddot = Q_ddot_p(t) + P z_ddot, G = g_Q.  By the implicit function
+theorem, with u = (z_ddot, lambda),
+
+    du/dy = -[dR/du]^-1 dR/dy,   dR/du = [[-M_r, C^T + P^T dF_mu/dlambda], [C, 0]],  C = G P.
+
+dR/dy is a sum of *local* pieces at frozen (Q_ddot, lambda): each element's F_e - M_e Q_ddot,e
+depends only on the element's coordinates, each constraint row only on the elements of its
+points (``NonlinearConstraint.coords``), the payload, ropes and friction only on their points'.
+Each piece is forward-differenced in its own coordinates, so a Jacobian costs about
+2 x (coordinates per element) element evaluations per element instead of 2 n_dof evaluations
+of the whole right-hand side (scipy BDF's ``num_jac``): at the paper's 8 sub-elements the
+telescopic Jacobian drops from 626 right-hand sides to the element work of ~40 (measured in
+``benchmarks/jacobian_speed.py``).  Pieces that do not say which coordinates they depend on are
+differenced in all of them (correct, only slower).  Checked against central differences of the
+whole right-hand side in ``tests/integrators/test_state_jacobian.py``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as sla
+
+_H = 1e-20                       # complex step of the quadratic velocity terms (as in constraints)
+REL_STEP = 1.5e-8                # ~sqrt(machine epsilon): forward-difference step per unit of |x|
+
+
+class JacobianCounter:
+    """``jac(t, y)`` for scipy's implicit solvers, counting calls and their cost in units of
+    whole right-hand-side evaluations (element evaluations / elements), for reproducible cost
+    bookkeeping of the method switch."""
+
+    def __init__(self, model):
+        self.model = model
+        self.n_calls = 0
+        self.rhs_equivalents = 0.0
+
+    def __call__(self, t, y):
+        J, cost = state_jacobian(self.model, t, y, return_cost=True)
+        self.n_calls += 1
+        self.rhs_equivalents += cost
+        return J
+
+
+def _steps(x: np.ndarray, rel_step: float) -> np.ndarray:
+    h = rel_step * np.maximum(np.abs(x), 1.0)
+    return (x + h) - x                    # exactly representable steps
+
+
+def _difference(fun, Q, Qd, cols, rel_step, central=False, which=(0, 1)):
+    """Forward (or central) differences of fun(Q, Q_dot) (a tuple of arrays) with respect to
+    Q[cols] (which 0) and Q_dot[cols] (which 1); returns a list with, per entry of ``which``,
+    a list (one per output) of arrays of shape (output shape, len(cols)).  Q and Q_dot are
+    perturbed in place and restored."""
+    base = None if central else fun(Q, Qd)
+    outs = []
+    for x in [(Q, Qd)[w] for w in which]:
+        hs = _steps(x[cols], rel_step)
+        d = None
+        for k, (j, h) in enumerate(zip(cols, hs)):
+            xj = x[j]
+            x[j] = xj + h
+            up = fun(Q, Qd)
+            if central:
+                x[j] = xj - h
+                lo = fun(Q, Qd)
+            x[j] = xj
+            if d is None:
+                d = [np.empty(np.shape(v) + (len(cols),)) for v in up]
+            for o, v, b in zip(d, up, lo if central else base):
+                o[..., k] = (v - b) / (2.0 * h if central else h)
+        outs.append(d if d is not None else [np.zeros(np.shape(v) + (0,)) for v in fun(Q, Qd)])
+    return outs
+
+
+def state_jacobian(model, t: float, y: np.ndarray, rel_step: float = REL_STEP,
+                   central: bool = False, return_cost: bool = False):
+    """d y' / d y (2 n_dof x 2 n_dof) of ``model.rhs`` at (t, y); see the module docstring.
+    ``central``: central instead of forward differences (twice the work; truncation error
+    O(h^2) instead of O(h), for checks).  With ``return_cost`` also the cost in whole
+    right-hand-side evaluations."""
+    n, N = model.n_dof, model.n_coords
+    y = np.asarray(y, dtype=float)
+    z, zd = y[:n], y[n:]
+    zdd, lam = model.accelerations_and_multipliers(t, z, zd)
+    Q, Qd = model.full_state(t, z, zd)
+    Q, Qd = Q.copy(), Qd.copy()
+    Qdd = model.A_pinv @ model._b(t, 2) + model.P @ zdd
+    m = len(lam)
+    dR1 = np.zeros((N, 2 * N))            # d/d(Q, Q_dot) of F + F_mu - M Q_ddot + G^T lambda
+    dR2 = np.zeros((m, 2 * N))            # d/d(Q, Q_dot) of G Q_ddot - rhs
+    n_el = 0
+    el_evals = 0
+
+    # elements: F_e(q_e, qd_e) - M_e(q_e) qdd_e in the element's own coordinates; the rate
+    # columns reuse the position-level kinematics and skip the mass matrix (M_e does not depend
+    # on rates)
+    for b, off in zip(model.beams, model.offsets):
+        for el, imap in zip(b.elements, b.index_map):
+            idx = off + imap
+            qdde = Qdd[idx]
+            qe, qde = Q[idx].copy(), Qd[idx].copy()
+            ctx0 = model.element_context(t, el, qe, qde)
+
+            def by_position(qx, qdx, el=el, qdde=qdde):
+                Me, Fe = model.element_mass_force(model.element_context(t, el, qx, qdx))
+                return (Fe - Me @ qdde,)
+
+            def by_rate(qx, qdx, el=el, kin=ctx0.kin):
+                return (model.element_mass_force(model.element_context(t, el, qx, qdx, kin),
+                                                 mass=False)[1],)
+
+            cols = np.arange(len(idx))
+            dR1[np.ix_(idx, idx)] += _difference(by_position, qe, qde, cols, rel_step, central,
+                                                 which=(0,))[0][0]
+            dR1[np.ix_(idx, N + idx)] += _difference(by_rate, qe, qde, cols, rel_step, central,
+                                                     which=(1,))[0][0]
+            n_el += 1
+            el_evals += (4 if central else 2) * len(idx) + 1
+
+    # pieces acting through points (point loads, payload, ropes, constraints, friction): each
+    # says which coordinates it depends on; they are differenced column by column together, so
+    # a point shared by several pieces is evaluated once per column (its cache is keyed on its
+    # own coordinates, sim_core.constraints.material_point)
+    pieces = []                            # (Q columns, Q_dot columns, fun -> (r1 (N,), r2), rows)
+
+    def cols_of(obj, attr="coords"):
+        c = getattr(obj, attr)(Q) if hasattr(obj, attr) else None
+        return np.arange(N) if c is None else np.asarray(c, dtype=int)
+
+    for pl in model.point_loads:           # J_r(s)^T f at the element that holds the load point
+        beam, off = model.beams[pl.beam], model.offsets[pl.beam]
+        e = model._element_at(pl.beam, Q, float(pl.s_of_t(t)))
+
+        def point_load(Qx, Qdx, pl=pl):
+            F = np.zeros(N)
+            model._add_point_load(pl, t, Qx, F)
+            return F, None
+        pieces.append((off + beam.index_map[e], np.zeros(0, int), point_load, None))
+
+    for pe in model.point_effects:         # payload, ropes: F_pe - M_pe Q_ddot
+        def point_effect(Qx, Qdx, pe=pe):
+            M = np.zeros((N, N))
+            F = np.zeros(N)
+            pe.add(t, Qx, Qdx, M, F)
+            return F - M @ Qdd, None
+        pieces.append((cols_of(pe), cols_of(pe, "velocity_coords"), point_effect, None))
+
+    # constraints: G^T lambda and G Q_ddot - (b_ddot - g_QQ[Qd, Qd] - 2 xi1 Phi_dot - xi2^2 Phi);
+    # their Q_dot derivatives are exact: d/dQ_dot of g_QQ[Qd, Qd] = 2 (dG/dQ . Qd), the imaginary
+    # part of the complex-step Jacobian G(Q + i h Q_dot) / h
+    xi1, xi2 = model.baumgarte
+    row = 0
+    for c in model.nonlinear:
+        sl = slice(row, row + c.m)
+        row += c.m
+        b0, bd, bdd = c.b(t)
+
+        def constraint(Qx, Qdx, c=c, lam_c=lam[sl], b0=b0, bd=bd, bdd=bdd):
+            g, J = c.evaluate(Qx)
+            _, Jc = c.evaluate(Qx + 1j * _H * Qdx)
+            g, J = np.real(g), np.real(J)
+            quad = (Jc @ Qdx).imag / _H
+            rhs = bdd - quad - 2.0 * xi1 * (J @ Qdx - bd) - xi2 ** 2 * (g - b0)
+            return J.T @ lam_c, J @ Qdd - rhs
+        pieces.append((cols_of(c), np.zeros(0, int), constraint, sl))
+        _, J = c.evaluate(Q)
+        _, Jc = c.evaluate(Q + 1j * _H * Qd)
+        dR2[sl, N:] += 2.0 * np.imag(Jc) / _H + 2.0 * xi1 * np.real(J)
+
+    # friction forces (Section 8.3); their multiplier derivative is formed below
+    for mf in model.multiplier_forces:
+        pieces.append((cols_of(mf), cols_of(mf, "velocity_coords"),
+                       lambda Qx, Qdx, mf=mf: (mf.forces(t, Qx, Qdx, lam), None), None))
+
+    base = [None if central else fun(Q, Qd) for _, _, fun, _ in pieces]
+    for which, x in enumerate((Q, Qd)):
+        users: dict[int, list[int]] = {}
+        for k, piece in enumerate(pieces):
+            for j in piece[which]:
+                users.setdefault(int(j), []).append(k)
+        cols = np.array(sorted(users), dtype=int)
+        for j, h in zip(cols, _steps(x[cols], rel_step)):
+            xj = x[j]
+            x[j] = xj + h
+            up = [pieces[k][2](Q, Qd) for k in users[j]]
+            if central:
+                x[j] = xj - h
+                lo = [pieces[k][2](Q, Qd) for k in users[j]]
+            else:
+                lo = [base[k] for k in users[j]]
+            x[j] = xj
+            col = j + which * N
+            scale = 1.0 / (2.0 * h if central else h)
+            for k, u, l in zip(users[j], up, lo):
+                dR1[:, col] += (u[0] - l[0]) * scale
+                if pieces[k][3] is not None:
+                    dR2[pieces[k][3], col] += (u[1] - l[1]) * scale
+
+    dF_dlam = np.zeros((N, m))
+    for mf in model.multiplier_forces:
+        f0 = mf.forces(t, Q, Qd, lam)
+        lx = lam.copy()
+        for i, h in enumerate(_steps(lam, rel_step)):
+            li = lx[i]
+            lx[i] = li + h
+            up = mf.forces(t, Q, Qd, lx)
+            if central:
+                lx[i] = li - h
+                dF_dlam[:, i] += (up - mf.forces(t, Q, Qd, lx)) / (2.0 * h)
+            else:
+                dF_dlam[:, i] += (up - f0) / h
+            lx[i] = li
+
+    # reduced coordinates and the saddle-point solve
+    P = model.P
+    Mr, _ = model.reduced_mass_force(t, z, zd)
+    if m:
+        from .constraints import constraint_terms
+        G = constraint_terms(model.nonlinear, t, Q, Qd)[1]
+        C = G @ P
+    else:
+        C = np.zeros((0, n))
+    A = np.zeros((n + m, n + m))
+    A[:n, :n] = -Mr
+    A[:n, n:] = C.T + P.T @ dF_dlam
+    A[n:, :n] = C
+    B = np.empty((n + m, 2 * n))
+    B[:n, :n] = P.T @ dR1[:, :N] @ P
+    B[:n, n:] = P.T @ dR1[:, N:] @ P
+    B[n:, :n] = dR2[:, :N] @ P
+    B[n:, n:] = dR2[:, N:] @ P
+    dU = -sla.solve(A, B)
+    jac = np.zeros((2 * n, 2 * n))
+    jac[:n, n:] = np.eye(n)
+    jac[n:] = dU[:n]
+    if return_cost:
+        return jac, el_evals / max(n_el, 1)
+    return jac
