@@ -19,7 +19,7 @@ points (``NonlinearConstraint.coords``), the payload, ropes and friction only on
 Each piece is forward-differenced in its own coordinates, so a Jacobian costs about
 2 x (coordinates per element) element evaluations per element instead of 2 n_dof evaluations
 of the whole right-hand side (scipy BDF's ``num_jac``): at the paper's 8 sub-elements the
-telescopic Jacobian drops from 626 right-hand sides to the element work of ~40 (measured in
+telescopic Jacobian costs ~100 right-hand sides instead of ~880 (measured in
 ``benchmarks/jacobian_speed.py``).  Pieces that do not say which coordinates they depend on are
 differenced in all of them (correct, only slower).  Checked against central differences of the
 whole right-hand side in ``tests/integrators/test_state_jacobian.py``.
@@ -32,23 +32,6 @@ import scipy.linalg as sla
 
 _H = 1e-20                       # complex step of the quadratic velocity terms (as in constraints)
 REL_STEP = 1.5e-8                # ~sqrt(machine epsilon): forward-difference step per unit of |x|
-
-
-class JacobianCounter:
-    """``jac(t, y)`` for scipy's implicit solvers, counting calls and their cost in units of
-    whole right-hand-side evaluations (element evaluations / elements), for reproducible cost
-    bookkeeping of the method switch."""
-
-    def __init__(self, model):
-        self.model = model
-        self.n_calls = 0
-        self.rhs_equivalents = 0.0
-
-    def __call__(self, t, y):
-        J, cost = state_jacobian(self.model, t, y, return_cost=True)
-        self.n_calls += 1
-        self.rhs_equivalents += cost
-        return J
 
 
 def _steps(x: np.ndarray, rel_step: float) -> np.ndarray:
