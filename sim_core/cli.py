@@ -137,8 +137,8 @@ def _plots(result: Result, out: Path) -> list:
     except ImportError:
         print("boom-sim: warning: matplotlib is not installed, figures skipped", file=sys.stderr)
         return []
-    from .plots import plot_result
-    return plot_result(result, out) + _folding_plots(result, out)
+    from .plots import plot_result, plot_telescopic
+    return plot_result(result, out) + plot_telescopic(result, out) + _folding_plots(result, out)
 
 
 def _folding_plots(result: Result, out: Path) -> list:
@@ -206,8 +206,8 @@ def cmd_plot(args) -> int:
         import matplotlib  # noqa: F401
     except ImportError:
         raise _InputError("matplotlib is not installed (pip install matplotlib)") from None
-    from .plots import plot_result
-    figs = plot_result(res, out) + _folding_plots(res, out)
+    from .plots import plot_result, plot_telescopic
+    figs = plot_result(res, out) + plot_telescopic(res, out) + _folding_plots(res, out)
     print(f"wrote {len(figs)} figures to {out}")
     return 0
 

@@ -30,6 +30,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg as sla
 
+from .constraints import constraint_terms
+
 _H = 1e-20                       # complex step of the quadratic velocity terms (as in constraints)
 REL_STEP = 1.5e-8                # ~sqrt(machine epsilon): forward-difference step per unit of |x|
 
@@ -208,7 +210,6 @@ def state_jacobian(model, t: float, y: np.ndarray, rel_step: float = REL_STEP,
     P = model.P
     Mr, _ = model.reduced_mass_force(t, z, zd)
     if m:
-        from .constraints import constraint_terms
         G = constraint_terms(model.nonlinear, t, Q, Qd)[1]
         C = G @ P
     else:
