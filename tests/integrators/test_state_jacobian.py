@@ -132,3 +132,19 @@ def test_unknown_jacobian_is_rejected():
     from sim_core.scene import SceneError, solver_table
     with pytest.raises(SceneError, match="solver.jacobian"):
         solver_table({"t_end": 1.0, "jacobian": "analytic"})
+
+
+def test_folding_jacobian_without_point_dependencies():
+    """The folding manipulator's rigid-body points and spring-damper cylinders do not say which
+    coordinates they depend on: those pieces are differenced in every coordinate (the general
+    path) - same check, on a random subset of columns."""
+    from sim_core.folding import FoldingParams, build_folding
+    fs = build_folding(FoldingParams(n_nodes=3))
+    m = fs.model
+    assert any(c.points is None for c in m.nonlinear)
+    rng = np.random.default_rng(0)
+    z, _ = m.reduced_state(0.0, fs.Q0, np.zeros_like(fs.Q0))
+    y = np.concatenate([z + 1e-4 * rng.standard_normal(len(z)), 1e-2 * rng.standard_normal(len(z))])
+    cols = rng.choice(len(y), size=30, replace=False)
+    err, spread = _check(m, 0.5, y, cols)
+    assert err < max(20.0 * spread, 1e-7), (err, spread)
