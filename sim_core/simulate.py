@@ -239,6 +239,8 @@ def integrate(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
                "method": method, "real_time_factor": t_end / max(wall, 1e-12)}
         if method != "RK45":
             out["n_jacobians"] = njev + int(getattr(solver, "njev", 0))
+            if structured:      # their work, in right-hand sides (element evaluations / elements)
+                out["jacobian_cost_rhs"] = float(rhs.jac_cost)
         if switch is not None:
             out["n_method_switches"] = len(switch.switches)
             out["first_switch_to_bdf_s"] = switch.switches[0][0] if switch.switches else -1.0

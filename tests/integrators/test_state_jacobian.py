@@ -123,6 +123,10 @@ def test_bdf_with_structured_jacobian_converges_with_the_tolerance():
         _, y, st = integrate(model, y0, 0.1, {"rtol": rtol, "atol": atol, "n_output": 6,
                                               "method": "BDF", "jacobian": "structured"})
         assert st["n_jacobians"] >= 1
+        # each structured Jacobian costs 2 x (element coordinates) + 1 element evaluations per
+        # element, reported in right-hand sides
+        el = model.beams[0].elements[0]
+        assert st["jacobian_cost_rhs"] == pytest.approx(st["n_jacobians"] * (2 * el.n_coords + 1))
         e = (y - y_ref) / (1e-8 + 1e-6 * np.abs(y_ref))
         errors.append(np.max(np.sqrt(np.mean(e ** 2, axis=1))))
     assert errors[1] < errors[0] / 10.0, errors
