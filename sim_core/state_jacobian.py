@@ -41,30 +41,23 @@ def _steps(x: np.ndarray, rel_step: float) -> np.ndarray:
     return (x + h) - x                    # exactly representable steps
 
 
-def _difference(fun, Q, Qd, cols, rel_step, central=False, which=(0, 1)):
-    """Forward (or central) differences of fun(Q, Q_dot) (a tuple of arrays) with respect to
-    Q[cols] (which 0) and Q_dot[cols] (which 1); returns a list with, per entry of ``which``,
-    a list (one per output) of arrays of shape (output shape, len(cols)).  Q and Q_dot are
-    perturbed in place and restored."""
-    base = None if central else fun(Q, Qd)
-    outs = []
-    for x in [(Q, Qd)[w] for w in which]:
-        hs = _steps(x[cols], rel_step)
-        d = None
-        for k, (j, h) in enumerate(zip(cols, hs)):
-            xj = x[j]
-            x[j] = xj + h
-            up = fun(Q, Qd)
-            if central:
-                x[j] = xj - h
-                lo = fun(Q, Qd)
-            x[j] = xj
-            if d is None:
-                d = [np.empty(np.shape(v) + (len(cols),)) for v in up]
-            for o, v, b in zip(d, up, lo if central else base):
-                o[..., k] = (v - b) / (2.0 * h if central else h)
-        outs.append(d if d is not None else [np.zeros(np.shape(v) + (0,)) for v in fun(Q, Qd)])
-    return outs
+def _difference(fun, x: np.ndarray, cols, rel_step: float, central: bool = False):
+    """Forward (or central) differences of fun() (an array that reads ``x``) with respect to
+    x[cols]: shape (fun's shape, len(cols)).  x is perturbed in place and restored."""
+    base = None if central else fun()
+    d = None
+    for k, (j, h) in enumerate(zip(cols, _steps(x[cols], rel_step))):
+        xj = x[j]
+        x[j] = xj + h
+        up = fun()
+        if central:
+            x[j] = xj - h
+            lo = fun()
+        x[j] = xj
+        if d is None:
+            d = np.empty(np.shape(up) + (len(cols),))
+        d[..., k] = (up - lo) / (2.0 * h) if central else (up - base) / h
+    return d if d is not None else np.zeros(np.shape(fun()) + (0,))
 
 
 def state_jacobian(model, t: float, y: np.ndarray, rel_step: float = REL_STEP,
@@ -96,19 +89,17 @@ def state_jacobian(model, t: float, y: np.ndarray, rel_step: float = REL_STEP,
             qe, qde = Q[idx].copy(), Qd[idx].copy()
             ctx0 = model.element_context(t, el, qe, qde)
 
-            def by_position(qx, qdx, el=el, qdde=qdde):
-                Me, Fe = model.element_mass_force(model.element_context(t, el, qx, qdx))
-                return (Fe - Me @ qdde,)
+            def by_position(el=el, qe=qe, qde=qde, qdde=qdde):
+                Me, Fe = model.element_mass_force(model.element_context(t, el, qe, qde))
+                return Fe - Me @ qdde
 
-            def by_rate(qx, qdx, el=el, kin=ctx0.kin):
-                return (model.element_mass_force(model.element_context(t, el, qx, qdx, kin),
-                                                 mass=False)[1],)
+            def by_rate(el=el, qe=qe, qde=qde, kin=ctx0.kin):
+                return model.element_mass_force(model.element_context(t, el, qe, qde, kin),
+                                                mass=False)[1]
 
             cols = np.arange(len(idx))
-            dR1[np.ix_(idx, idx)] += _difference(by_position, qe, qde, cols, rel_step, central,
-                                                 which=(0,))[0][0]
-            dR1[np.ix_(idx, N + idx)] += _difference(by_rate, qe, qde, cols, rel_step, central,
-                                                     which=(1,))[0][0]
+            dR1[np.ix_(idx, idx)] += _difference(by_position, qe, cols, rel_step, central)
+            dR1[np.ix_(idx, N + idx)] += _difference(by_rate, qde, cols, rel_step, central)
             n_el += 1
             el_evals += (4 if central else 2) * len(idx) + 1
 
@@ -193,18 +184,9 @@ def state_jacobian(model, t: float, y: np.ndarray, rel_step: float = REL_STEP,
 
     dF_dlam = np.zeros((N, m))
     for mf in model.multiplier_forces:
-        f0 = mf.forces(t, Q, Qd, lam)
         lx = lam.copy()
-        for i, h in enumerate(_steps(lam, rel_step)):
-            li = lx[i]
-            lx[i] = li + h
-            up = mf.forces(t, Q, Qd, lx)
-            if central:
-                lx[i] = li - h
-                dF_dlam[:, i] += (up - mf.forces(t, Q, Qd, lx)) / (2.0 * h)
-            else:
-                dF_dlam[:, i] += (up - f0) / h
-            lx[i] = li
+        dF_dlam += _difference(lambda mf=mf: mf.forces(t, Q, Qd, lx), lx, np.arange(m),
+                               rel_step, central)
 
     # reduced coordinates and the saddle-point solve
     P = model.P
