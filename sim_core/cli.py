@@ -137,15 +137,17 @@ def _plots(result: Result, out: Path) -> list:
     except ImportError:
         print("boom-sim: warning: matplotlib is not installed, figures skipped", file=sys.stderr)
         return []
+    return _figures(result, out)
+
+
+def _figures(result: Result, out: Path) -> list:
+    """Every figure that applies to the result (``run`` and ``plot``)."""
     from .plots import plot_result, plot_telescopic
-    return plot_result(result, out) + plot_telescopic(result, out) + _folding_plots(result, out)
-
-
-def _folding_plots(result: Result, out: Path) -> list:
-    if result.scene.get("kind") != "folding" and result.scene.get("name") != "folding":
-        return []
-    from .folding_plots import plot_folding
-    return plot_folding(result, out)
+    figs = plot_result(result, out) + plot_telescopic(result, out)
+    if result.scene.get("kind") == "folding" or result.scene.get("name") == "folding":
+        from .folding_plots import plot_folding
+        figs += plot_folding(result, out)
+    return figs
 
 
 def cmd_list(args) -> int:
@@ -206,8 +208,7 @@ def cmd_plot(args) -> int:
         import matplotlib  # noqa: F401
     except ImportError:
         raise _InputError("matplotlib is not installed (pip install matplotlib)") from None
-    from .plots import plot_result, plot_telescopic
-    figs = plot_result(res, out) + plot_telescopic(res, out) + _folding_plots(res, out)
+    figs = _figures(res, out)
     print(f"wrote {len(figs)} figures to {out}")
     return 0
 
