@@ -217,6 +217,13 @@ class EquilibriumPath:
     displacement: list[float] = field(default_factory=list)
     tangent_load: list[float] = field(default_factory=list)
 
+    def add(self, load_factor: float, arclength: float, displacement: float,
+            tangent_load: float) -> None:
+        self.load_factor.append(float(load_factor))
+        self.arclength.append(float(arclength))
+        self.displacement.append(float(displacement))
+        self.tangent_load.append(float(tangent_load))
+
 
 def load_continuation(model: Model, z0: np.ndarray, t: float = 0.0, tol: float = 1e-7,
                       target: float = 1.0, ds0: float = 0.05, ds_max: float = 0.25,
@@ -296,10 +303,7 @@ def load_continuation(model: Model, z0: np.ndarray, t: float = 0.0, tol: float =
         direction = np.concatenate([c * v / z_ref, [c]])
         if prev_dir is not None and direction @ prev_dir < 0:
             c, direction = -c, -direction
-        path.load_factor.append(lg)
-        path.arclength.append(s)
-        path.displacement.append(float(np.linalg.norm(z - z_un) / z_ref))
-        path.tangent_load.append(float(c))
+        path.add(lg, s, np.linalg.norm(z - z_un) / z_ref, c)
         if prev_dir is not None and c < 0:                       # the path turned back
             lams = np.array(path.load_factor[-3:])
             ss = np.array(path.arclength[-3:])
@@ -355,10 +359,7 @@ def load_continuation(model: Model, z0: np.ndarray, t: float = 0.0, tol: float =
             with gravity_scaled(model, target):
                 zt, mt = constrained_static_equilibrium(model, z + w * (zi - z), t, tol=tol,
                                                         continuation=False)
-            path.load_factor.append(target)
-            path.arclength.append(s + w * ds)
-            path.displacement.append(float(np.linalg.norm(zt - z_un) / z_ref))
-            path.tangent_load.append(float("nan"))
+            path.add(target, s + w * ds, np.linalg.norm(zt - z_un) / z_ref, np.nan)
             return zt, mt
         prev = (z, mu, lg, ds)
         z, mu, lg, s = zi, mui, li, s + ds
