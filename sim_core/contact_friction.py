@@ -7,8 +7,9 @@ micro-motion solver (Eqs. 59-71, :mod:`sim_core.contact.sliding_block_contact`);
 force mu(s_dot) * sum(f_ij) (Eq. 65, regularised law of SCENARIOS A6) acts along e_s.  Its
 virtual power under a relative slide is  -mu(s_dot) N delta s_dot  (Section 7: the contact
 multiplier eta), so it enters the equations as the generalized force -mu(s_dot) N on the contact
-coordinate s_2,k or s_3,k+1.  Because N depends on the multipliers, the model iterates the
-multipliers to a fixed point (Model.multiplier_forces).
+coordinate s_2,k or s_3,k+1.  Because N depends on the multipliers, the model solves for the
+friction values and the multipliers together (Model.multiplier_forces): by Newton in the four
+values -mu N, with the analytic sensitivity of the micro-motion solve (FrictionAtState).
 """
 
 from __future__ import annotations
@@ -20,22 +21,28 @@ from .constraints import dependencies
 from .contact import FrictionLaw, SliderGeometry, SpringLaw, solve_micro_motion
 
 
-def section_reaction(point, Q, lam_point, lam_angles, basis):
-    """Force and moment (section components (s, t, b)) that a coincidence constraint with
-    multipliers (lam_point, lam_angles) exerts on its *second* body b (g = r_a - r_b): -lambda,
-    the moment from the Cardan-angle multipliers m = T^-T lambda_psi (Eq. 31)."""
+def section_reaction_maps(point, Q, basis, n_angles: int = 3):
+    """The linear maps from a coincidence constraint's multipliers to the force and moment it
+    exerts on its *second* body b (g = r_a - r_b), section components (s, t, b):
+    f_sec = Lf lam_point (f = -lambda in global components) and m_sec = Lm lam_angles (the
+    moment from the Cardan-angle multipliers, m = -T^-T lambda_psi, Eq. 31).  ``n_angles`` = 2
+    without the twist row (effects.torsion = false).  Returns (Lf (3, 3), Lm (3, n_angles))."""
     _, _, psi, _ = point(Q)
-    lam_angles = np.asarray(lam_angles)
-    if lam_angles.shape[0] == 2:          # effects.torsion = false: no gamma row, no twist moment
-        lam_angles = np.array([lam_angles[0], lam_angles[1], 0.0])
     frame = cardan_frame(*psi) @ basis.T                 # rows e_t, e_b, e_s (global)
     sb, cb = np.sin(psi[1]), np.cos(psi[1])
     sg, cg = np.sin(psi[2]), np.cos(psi[2])
     T = np.array([[sb, 0.0, 1.0], [cb * cg, sg, 0.0], [-cb * sg, cg, 0.0]])
-    m_sec = -np.linalg.solve(T.T, lam_angles)
-    f = -np.asarray(lam_point)
-    f_sec = np.array([frame[2] @ f, frame[0] @ f, frame[1] @ f])
-    return f_sec, m_sec
+    Lm = -np.linalg.inv(T.T)[:, :n_angles]
+    return -frame[[2, 0, 1]], Lm
+
+
+def section_reaction(point, Q, lam_point, lam_angles, basis):
+    """Force and moment (section components (s, t, b)) that a coincidence constraint with
+    multipliers (lam_point, lam_angles) exerts on its *second* body (see
+    :func:`section_reaction_maps`)."""
+    lam_angles = np.asarray(lam_angles)
+    Lf, Lm = section_reaction_maps(point, Q, basis, lam_angles.shape[0])
+    return Lf @ np.asarray(lam_point), Lm @ lam_angles
 
 
 class ContactFriction:
@@ -80,28 +87,76 @@ class ContactFriction:
         """Rates in the friction law: the contact coordinates' (s_dot of Eq. 65)."""
         return np.array([s_idx for _, _, s_idx, _ in self.regions], dtype=int)
 
+    def at_state(self, t, Q, Qd) -> "FrictionAtState":
+        """The friction as a function of the multipliers alone, at the state (Q, Qd): the
+        section maps and mu(s_dot) are formed once here, not in every multiplier iteration."""
+        rows = self.ts.rows
+        regions = []
+        for name, point, s_idx, geom in self.regions:
+            rp, ra = rows[name + "_point"], rows[name + "_angles"]
+            Lf, Lm = section_reaction_maps(point, Q, self.basis, ra.stop - ra.start)
+            regions.append((name, s_idx, rp, ra, Lf, Lm, self.law.mu(float(Qd[s_idx])), geom))
+        return FrictionAtState(self, regions)
+
     def solve_regions(self, Q, Qd, lam):
         """Per region: (name, s_index, mu, ContactSolution) (distribution on) or
         (name, s_index, mu, N) with the transverse resultant N in N (distribution off)."""
-        rows = self.ts.rows
+        return self.at_state(0.0, Q, Qd).solve_regions(lam)
+
+    def forces(self, t, Q, Qd, lam):
+        """Generalized friction forces (N, on the contact coordinates), length of Q."""
+        at = self.at_state(t, Q, Qd)
+        dF = np.zeros(len(Q))
+        np.add.at(dF, at.coords, at.values(lam)[0])
+        return dF
+
+
+class FrictionAtState:
+    """Friction forces at a fixed state as a function of the multipliers lambda.
+
+    They act on k = 2 (n_booms - 1) coordinates only (the contact coordinates), so they are the
+    low-rank term  F_mu(lambda) = E g(lambda),  g_r = -mu_r N_r(lambda)  (Eq. 65 with the
+    regularised law), that :meth:`sim_core.model.Model.accelerations_and_multipliers` solves
+    by Newton in the k values g."""
+
+    def __init__(self, owner: ContactFriction, regions: list):
+        self.owner = owner
+        self.regions = regions
+        self.coords = np.array([r[1] for r in regions], dtype=int)
+
+    def solve_regions(self, lam):
         out = []
-        for name, point, s_idx, geom in self.regions:
-            f_c, m_c = section_reaction(point, Q, lam[rows[name + "_point"]],
-                                        lam[rows[name + "_angles"]], self.basis)
-            mu = self.law.mu(float(Qd[s_idx]))
+        x0 = self.owner._x0
+        spring = self.owner.spring
+        for name, s_idx, rp, ra, Lf, Lm, mu, geom in self.regions:
+            f_c, m_c = Lf @ lam[rp], Lm @ lam[ra]
             if geom is None:
                 out.append((name, s_idx, mu, float(np.hypot(f_c[1], f_c[2]))))
                 continue
-            sol = solve_micro_motion(geom, self.spring, f_c, m_c, mu, x0=self._x0.get(name))
-            self._x0[name] = sol.x
+            sol = solve_micro_motion(geom, spring, f_c, m_c, mu, x0=x0.get(name))
+            x0[name] = sol.x
             out.append((name, s_idx, mu, sol))
         return out
 
-    def forces(self, t, Q, Qd, lam):
-        dF = np.zeros(len(Q))
-        for _, s_idx, mu, sol in self.solve_regions(Q, Qd, lam):
-            dF[s_idx] -= mu * (sol if geom_free(sol) else sol.total_normal_force)
-        return dF
+    def values(self, lam, gradient: bool = False):
+        """(g (k,), dg/dlambda (k, m) or None): g_r = -mu_r N_r, N the region's slider-spring
+        sum (micro-motion solve, Eqs. 59-71) or its transverse resultant |(f_t, f_b)|."""
+        g = np.empty(len(self.regions))
+        dg = np.zeros((len(self.regions), len(lam))) if gradient else None
+        for r, ((_, _, mu, sol), (_, _, rp, ra, Lf, Lm, _, _)) in enumerate(
+                zip(self.solve_regions(lam), self.regions)):
+            if geom_free(sol):
+                g[r] = -mu * sol
+                if gradient and sol > 0.0:
+                    ftb = Lf[1:3] @ lam[rp]
+                    dg[r, rp] = -mu * (ftb / sol) @ Lf[1:3]
+                continue
+            g[r] = -mu * sol.total_normal_force
+            if gradient and mu != 0.0:
+                dN = sol.normal_load_gradient()        # d N / d(f_t, f_b, m_s, m_t, m_b)
+                dg[r, rp] = -mu * (dN[:2] @ Lf[1:3])
+                dg[r, ra] = -mu * (dN[2:] @ Lm)
+        return g, dg
 
 
 def geom_free(sol) -> bool:

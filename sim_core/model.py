@@ -53,9 +53,12 @@ class Model:
     point_effects: list = field(default_factory=list)      # point_effects.PointMass, RopeDrive
     n_extra: int = 0            # extra coordinates after the beams (e.g. inner contact points s_2,k)
     # forces that depend on the constraint multipliers (contact friction, Section 8.3): objects
-    # with forces(t, Q, Qd, lam) -> (N,); solved by fixed-point iteration on lambda
+    # with forces(t, Q, Qd, lam) -> (N,).  With at_state(t, Q, Qd) -> an object with .coords (k,)
+    # and .values(lam, gradient) -> (g (k,), dg/dlam (k, m)) (forces E g(lam) on k coordinates)
+    # they are solved by Newton in g; otherwise by fixed-point iteration on lambda
     multiplier_forces: list = field(default_factory=list)
     multiplier_tol: float = 1e-8
+    multiplier_newton: bool = True     # False: the fixed point even where at_state is offered
     multiplier_max_iter: int = 8
     baumgarte: tuple[float, float] = (10.0, 10.0)          # xi1, xi2 in 1/s (second seed Eq. 8)
 
@@ -217,6 +220,8 @@ class Model:
         if not self.multiplier_forces:
             return kkt_accelerations(Mr, Fr, J @ self.P, c_rhs)
         solve = kkt_factor(Mr, J @ self.P)
+        if self.multiplier_newton and all(hasattr(mf, "at_state") for mf in self.multiplier_forces):
+            return self._multiplier_newton(t, Q, Qd, solve, Fr, c_rhs)
         zdd, lam = solve(Fr, c_rhs)
         for _ in range(self.multiplier_max_iter):
             dF = sum(mf.forces(t, Q, Qd, lam) for mf in self.multiplier_forces)
@@ -226,6 +231,50 @@ class Model:
             if change < self.multiplier_tol:
                 break
         return zdd, lam
+
+    def _multiplier_newton(self, t, Q, Qd, solve, Fr, c_rhs):
+        """Multiplier-dependent forces E g(lambda) on k coordinates (friction: the contact
+        coordinates, Section 8.3): the saddle-point solution is affine in g,
+        (z_ddot, lambda) = (z0, lam0) + (Z, L) g  (one factorisation, k + 1 right-hand sides),
+        so the coupled problem is the k-dimensional  r(g) = g - g(lam0 + L g) = 0,  solved by
+        Newton with the Jacobian  I - (dg/dlambda) L  (dg/dlambda analytic: the micro-motion
+        sensitivity, ContactSolution.normal_load_gradient).  A Newton step that does not reduce |r|
+        is replaced by the fixed-point step g <- g(lambda).  Stops when a Newton step changes
+        lambda by less than multiplier_tol (relative to max |lambda|, at least 1); the step is
+        taken, its error is of the order of its square."""
+        ats = [mf.at_state(t, Q, Qd) for mf in self.multiplier_forces]
+        idx = np.concatenate([a.coords for a in ats])
+        k = len(idx)
+        if k == 0:
+            return solve(Fr, c_rhs)
+        sol = solve(np.column_stack([Fr, self.P[idx].T]),
+                    np.column_stack([c_rhs, np.zeros((len(c_rhs), k))]))
+        zdd0, Z = sol[0][:, 0], sol[0][:, 1:]
+        lam0, L = sol[1][:, 0], sol[1][:, 1:]
+
+        def values(g):
+            lam = lam0 + L @ g
+            parts = [a.values(lam, gradient=True) for a in ats]
+            return lam, np.concatenate([p[0] for p in parts]), np.vstack([p[1] for p in parts])
+
+        g = np.zeros(k)
+        lam, gv, dg = values(g)
+        r = g - gv
+        for _ in range(self.multiplier_max_iter):
+            step = np.linalg.solve(np.eye(k) - dg @ L, -r)
+            g_new = g + step
+            dlam = L @ step
+            if np.max(np.abs(dlam)) < self.multiplier_tol * max(np.max(np.abs(lam + dlam)), 1.0):
+                g = g_new                 # converged: the last step is below the tolerance
+                break
+            lam_new, gv_new, dg_new = values(g_new)
+            r_new = g_new - gv_new
+            if np.max(np.abs(r_new)) > np.max(np.abs(r)):     # safeguard: fixed-point step
+                g_new = gv
+                lam_new, gv_new, dg_new = values(g_new)
+                r_new = g_new - gv_new
+            g, lam, gv, dg, r = g_new, lam_new, gv_new, dg_new, r_new
+        return zdd0 + Z @ g, lam0 + L @ g
 
     def constraint_violation(self, t: float, z: np.ndarray, zd: np.ndarray) -> np.ndarray:
         """Position-level violation of every nonlinear constraint row (m or rad)."""

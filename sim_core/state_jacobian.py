@@ -22,7 +22,9 @@ of the whole right-hand side (scipy BDF's ``num_jac``): at the paper's 8 sub-ele
 telescopic Jacobian costs ~100 right-hand sides instead of ~880 (measured in
 ``benchmarks/jacobian_speed.py``).  Pieces that do not say which coordinates they depend on are
 differenced in all of them (correct, only slower).  Checked against central differences of the
-whole right-hand side in ``tests/integrators/test_state_jacobian.py``.
+whole right-hand side in ``tests/integrators/test_state_jacobian.py``.  The friction's multiplier
+derivative dF_mu/dlambda is analytic (the micro-motion sensitivity of the friction Newton,
+:class:`sim_core.contact_friction.FrictionAtState`).
 """
 
 from __future__ import annotations
@@ -153,7 +155,8 @@ def state_jacobian(model, t: float, y: np.ndarray, rel_step: float = REL_STEP,
         _, Jc = c.evaluate(Q + 1j * _H * Qd)
         dR2[sl, N:] += 2.0 * np.imag(Jc) / _H + 2.0 * xi1 * np.real(J)
 
-    # friction forces (Section 8.3); their multiplier derivative is formed below
+    # friction forces (Section 8.3); their multiplier derivative is formed below (analytic where
+    # the force offers at_state, by differences otherwise)
     for mf in model.multiplier_forces:
         pieces.append((cols_of(mf), cols_of(mf, "velocity_coords"),
                        lambda Qx, Qdx, mf=mf: (mf.forces(t, Qx, Qdx, lam), None), None))
@@ -184,6 +187,10 @@ def state_jacobian(model, t: float, y: np.ndarray, rel_step: float = REL_STEP,
 
     dF_dlam = np.zeros((N, m))
     for mf in model.multiplier_forces:
+        if hasattr(mf, "at_state"):         # analytic: F_mu = E g(lambda), the friction Newton's
+            at = mf.at_state(t, Q, Qd)
+            np.add.at(dF_dlam, at.coords, at.values(lam, gradient=True)[1])
+            continue
         lx = lam.copy()
         dF_dlam += _difference(lambda mf=mf: mf.forces(t, Q, Qd, lx), lx, np.arange(m),
                                rel_step, central)

@@ -415,18 +415,29 @@ class ContactSolution:
         out[:, 0] -= self.friction_force
         return out
 
+    def normal_load_gradient(self) -> np.ndarray:
+        """d(sum f_ij)/dc, c = (f_c,t, f_c,b, m_c,s, m_c,t, m_c,b): how the region's normal load
+        (the friction load of Eq. 65) follows the section load at fixed mu; f_c,s does not
+        enter.  Implicit function theorem on Eqs. 67-71: dx/dc = -J^-1, so
+        dN/dc = -(J^-T A^T f')^T.  Rigid-motion directions that compress no active spring do
+        not change any force and are removed by a least-squares solve.  (5,), 1 and 1/m."""
+        return -self._load_sensitivity()
+
+    def _load_sensitivity(self) -> np.ndarray:
+        """z = J^-T A^T f' (least squares): d sum f / dc = -z."""
+        g = self.geometry
+        return np.linalg.lstsq(self.jacobian.T, g.AT @ self.tangent, rcond=1e-12)[0]
+
     def aux_gradient(self):
         """Sensitivities of the axial residual (Eq. 72) at this solution.
 
         Returns (d_aux/d_f_c (3,), d_aux/d_m_c (3,), d_aux/d_mu), by the implicit function
         theorem on Eqs. 67-71 (the micro-motions follow the load).  Use with FrictionLaw.dmu_dv
-        for the s_dot dependence.  Rigid-motion directions that compress no active spring do
-        not change any force and are removed by a least-squares solve.
+        for the s_dot dependence.
         """
         g = self.geometry
         # d fbar_s / dx = -mu f'^T A ; dx/dc = -J^-1  =>  d aux/dc = y^T, J^T y = mu A^T f'
-        rhs = self.mu * (g.AT @ self.tangent)
-        y = np.linalg.lstsq(self.jacobian.T, rhs, rcond=1e-12)[0]
+        y = self.mu * self._load_sensitivity()
         d_fc = np.array([1.0, y[0], y[1]])
         d_mc = y[2:5].copy()
         # dR/dmu = Bf^T f ; d aux/dmu = -sum f - mu f'^T A dx/dmu = -sum f + y . Bf^T f

@@ -364,6 +364,32 @@ def test_aux_gradient_matches_finite_differences():
     assert d_mu == pytest.approx(fd_mu, rel=1e-5)
 
 
+@pytest.mark.parametrize("mu", [0.0, 0.1, -0.15])
+def test_normal_load_gradient_matches_finite_differences(mu):
+    """d(sum f_ij)/d(f_t, f_b, m_s, m_t, m_b) (implicit function theorem, the friction Newton's
+    sensitivity) vs central differences of re-solved problems; steps and tolerance as in the
+    Eq. 72 gradient test above.  The axial force f_s does not enter Eqs. 67-71."""
+    g = region(2, "outer")
+    f_c, m_c = np.array([3e4, 4e3, -2.5e5]), np.array([5e3, 1e5, -4e3])
+    sol = solve_micro_motion(g, SPRING, f_c, m_c, mu, rtol=1e-13)
+    grad = sol.normal_load_gradient()
+    c5 = np.array([f_c[1], f_c[2], *m_c])
+
+    def load(c):
+        s = solve_micro_motion(g, SPRING, np.array([f_c[0], c[0], c[1]]), c[2:], mu,
+                               x0=sol.x, rtol=1e-13)
+        return s.total_normal_force
+
+    fd = np.empty(5)
+    for j in range(5):
+        h = 1e-4 * (abs(c5[j]) + 1e3)
+        e = np.zeros(5)
+        e[j] = h
+        fd[j] = (load(c5 + e) - load(c5 - e)) / (2 * h)
+    assert np.abs(grad).max() > 0.5           # the vertical load alone moves N by ~1 per N
+    np.testing.assert_allclose(grad, fd, rtol=0, atol=1e-5 * np.abs(grad).max())
+
+
 # ------------------------------------------------------------------------------- (6) laws
 
 def test_spring_law_continuity_and_c1():

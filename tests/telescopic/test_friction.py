@@ -95,3 +95,70 @@ def test_friction_flips_sign_between_extraction_and_retraction(systems):
         cyl[(v, 0)] = ts_0.model.accelerations_and_multipliers(0.0, z, zd0)[1][
             ts_0.rows["telescopic_cylinder"]][0]
     assert cyl[0.2] > cyl[(0.2, 0)] and cyl[-0.2] < cyl[(-0.2, 0)]
+
+
+@pytest.mark.parametrize("distribution", [True, False])
+def test_multiplier_newton_matches_the_converged_fixed_point(systems, distribution):
+    """The friction forces act on the 4 contact coordinates only, so the coupled
+    friction-multiplier problem is solved by Newton in those 4 values (Model._multiplier_newton).
+    It must give the fixed point's solution (iterated to 1e-13, relative), and - its Jacobian
+    being the analytic micro-motion sensitivity - in fewer friction evaluations than the fixed
+    point needs for the default 1e-8 (a wrong sensitivity loses the quadratic convergence)."""
+    import sim_core.contact_friction as cf
+
+    ts_f, _, z = systems
+    m = ts_f.model
+    fr = m.multiplier_forces[0]
+    saved = (fr.distribution, fr.regions, m.multiplier_tol, m.multiplier_max_iter)
+    if not distribution:
+        fr.regions = [(n, p, s, None) for n, p, s, _ in fr.regions]
+    Q, Qd = _sliding_state(ts_f, z, 0.3)
+    zd = m.reduced_state(0.0, Q, Qd)[1]
+    calls = []
+    values = cf.FrictionAtState.values
+
+    def counted(self, lam, gradient=False):
+        calls.append(1)
+        return values(self, lam, gradient)
+
+    try:
+        cf.FrictionAtState.values = counted
+        m.multiplier_newton, m.multiplier_tol, m.multiplier_max_iter = False, 1e-13, 60
+        a_ref, lam_ref = m.accelerations_and_multipliers(0.0, z, zd)
+        m.multiplier_tol, m.multiplier_max_iter = saved[2:]
+        calls.clear()
+        m.accelerations_and_multipliers(0.0, z, zd)
+        n_fixed = len(calls)
+        m.multiplier_newton = True
+        calls.clear()
+        a, lam = m.accelerations_and_multipliers(0.0, z, zd)
+        n_newton = len(calls)
+    finally:
+        cf.FrictionAtState.values = values
+        m.multiplier_newton = True
+        fr.distribution, fr.regions, m.multiplier_tol, m.multiplier_max_iter = saved
+    # the friction changes the multipliers by O(10 %): a 1e-9 agreement needs both solves
+    assert np.max(np.abs(lam - lam_ref)) < 1e-9 * np.max(np.abs(lam_ref))
+    assert np.max(np.abs(a - a_ref)) < 1e-9 * np.max(np.abs(a_ref))
+    assert n_newton < n_fixed
+
+
+def test_friction_multiplier_gradient_matches_finite_differences(systems):
+    """dg/dlambda of FrictionAtState (section maps and micro-motion sensitivity) vs central
+    differences in every multiplier; step 1e-6 of max |lambda|, tolerance 1e-5 of the largest
+    entry (truncation of the C1 spring law and the 1e-11 solver tolerance are far below)."""
+    ts_f, _, z = systems
+    m = ts_f.model
+    Q, Qd = _sliding_state(ts_f, z, 0.3)
+    zd = m.reduced_state(0.0, Q, Qd)[1]
+    _, lam = m.accelerations_and_multipliers(0.0, z, zd)
+    at = m.multiplier_forces[0].at_state(0.0, Q, Qd)
+    g, dg = at.values(lam, gradient=True)
+    h = 1e-6 * np.max(np.abs(lam))
+    fd = np.empty_like(dg)
+    for j in range(len(lam)):
+        e = np.zeros_like(lam)
+        e[j] = h
+        fd[:, j] = (at.values(lam + e)[0] - at.values(lam - e)[0]) / (2 * h)
+    assert np.all(g != 0.0)
+    np.testing.assert_allclose(dg, fd, rtol=0, atol=1e-5 * np.abs(dg).max())
