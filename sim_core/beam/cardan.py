@@ -20,6 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import cardan_compiled as _compiled
+
 
 def _atan2(y, x):
     """Complex-safe atan2 by the half-angle formula (valid away from the cut at angle +-pi)."""
@@ -70,6 +72,16 @@ def cardan_frame(alpha, beta, gamma) -> np.ndarray:
 
 def section_state(rp: np.ndarray, rpp: np.ndarray, gam: np.ndarray, gamp: np.ndarray,
                   basis: np.ndarray) -> SectionState:
+    """Strains, frames and derivatives from r' (G,3), r'' (G,3), gamma (G,), gamma' (G,): the
+    compiled loop of :mod:`sim_core.beam.cardan_compiled` where numba is installed, otherwise
+    :func:`section_state_numpy` (the reference; same formulas)."""
+    if _compiled.AVAILABLE:
+        return SectionState(*_compiled.section_state_arrays(rp, rpp, gam, gamp, basis))
+    return section_state_numpy(rp, rpp, gam, gamp, basis)
+
+
+def section_state_numpy(rp: np.ndarray, rpp: np.ndarray, gam: np.ndarray, gamp: np.ndarray,
+                        basis: np.ndarray) -> SectionState:
     """Strains, frames and derivatives from r' (G,3), r'' (G,3), gamma (G,), gamma' (G,).
 
     ``basis`` is the reference basis G (3x3, columns g1, g2, g3 in global components).
