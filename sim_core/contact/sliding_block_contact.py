@@ -73,6 +73,8 @@ from scipy.linalg.lapack import dgesv as _dgesv
 
 from sim_core.errors import SimulationError
 
+from . import micro_motion_compiled as _compiled
+
 __all__ = [
     "ContactSolution",
     "ContactSolveError",
@@ -554,6 +556,20 @@ def solve_micro_motion(geom: SliderGeometry, spring: SpringLaw, f_c, m_c, mu_val
 
     kappa_GA = (_KAPPA * spring.k0) * (geom.AtA + mu * geom.BftA)
     tol = rtol * load_scale
+    if _compiled.AVAILABLE and type(spring) is SpringLaw:
+        # the same Newton as the loop below, compiled (micro_motion_compiled)
+        x, status, it, err = _compiled.newton(A, GT, kappa_GA, c5, S, x, spring.k0, spring.eps,
+                                              tol, load_scale, max_iter)
+        delta = A @ x
+        f, fp = fat(delta)
+        R = c5 + GT @ f
+        if status == 0:
+            return finish(x, delta, f, fp, R, it)
+        reason = {1: "singular Newton matrix",
+                  2: f"line search failed (|S R| = {err:.3e}, tol {tol:.3e})",
+                  3: f"no convergence in {max_iter} Newton iterations "
+                     f"(|S R| = {err:.3e}, tol {tol:.3e})"}[status]
+        raise ContactSolveError(reason, t=t, iterations=it, residual=R, last_x=x)
     f, fp = fat(delta)
     R = c5 + GT @ f
     SR = S * R

@@ -1,0 +1,155 @@
+"""Where the time of the paper scene's right-hand side goes, and what each speed-up bought.
+
+One command (from the repository root):
+
+    OPENBLAS_NUM_THREADS=1 PYTHONPATH=. python benchmarks/telescopic_rhs_speed.py
+
+The paper's extraction scene (25 t, friction with the slider-spring distribution, stress filter,
+elastic ropes) at 8 sub-elements per spline element, at the static equilibrium with a small
+random velocity and every contact point sliding (the state of ``jacobian_speed.py``).  It times
+one ``Model.rhs`` (thread CPU time; minimum and median of 40 runs of 3 calls, the variants
+interleaved so that they share the machine's state) for
+
+* ``fixed point, numpy``  the friction multipliers by fixed-point iteration, numpy section state
+  (the code before 2026-11-24's changes),
+* ``Newton, numpy``       the friction solved by Newton in the four friction values,
+* ``Newton, compiled``    and the section state (Eqs. 24-33) as a compiled numba loop,
+
+then a cProfile of the fastest variant, grouped by what the time is spent on.  Ratios within one
+run are what the table is for; the machine may be shared.
+
+Writes benchmarks/results/telescopic_rhs_speed.md (atomically).
+"""
+
+from __future__ import annotations
+
+import cProfile
+import io
+import os
+import platform
+import pstats
+import sys
+import time
+from datetime import datetime, timezone
+
+import numpy as np
+
+sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..")))
+
+from sim_core import load_scene                               # noqa: E402
+from sim_core.beam import cardan_compiled                     # noqa: E402
+from sim_core.result import atomic_write_bytes                # noqa: E402
+from sim_core.telescopic import build_telescopic, initial_equilibrium   # noqa: E402
+from sim_core.telescopic_scene import params_from_scene       # noqa: E402
+
+OUT = os.path.join(os.path.dirname(__file__), "results", "telescopic_rhs_speed.md")
+
+# (label, multiplier Newton, compiled section state)
+VARIANTS = (("fixed point, numpy", False, False), ("Newton, numpy", True, False),
+            ("Newton, compiled", True, True))
+
+# cProfile groups: (label, function names whose cumulative time is the group's; nested
+# groups are subtracted from their parents below)
+GROUPS = (
+    ("friction (micro-motion solves, sensitivities)", ("values",)),
+    ("constraint rows (Jacobian, quadratic terms)", ("constraint_terms",)),
+    ("saddle-point factorisation", ("kkt_factor",)),
+    ("saddle-point solves", ("lu_solve",)),
+    ("point effects (payload, ropes)", ("add",)),
+    ("elements (kinematics, mass, forces)", ("element_contexts", "element_mass_force")),
+)
+
+
+def sliding_state(n_nodes: int = 9):
+    p = params_from_scene(load_scene("telescopic_extraction"))
+    p.n_nodes = n_nodes
+    ts = build_telescopic(p)
+    m = ts.model
+    z, _ = initial_equilibrium(ts)
+    t = 3.0
+    rng = np.random.default_rng(0)
+    Q, Qd = m.full_state(t, z, 1e-3 * rng.standard_normal(len(z)))
+    for i in ts.s2_index:
+        Qd[i] = 0.1
+    for i in ts.s3_index[1:]:
+        Qd[i] = -0.1
+    zz, zd = m.reduced_state(t, Q, Qd)
+    return m, t, np.concatenate([zz, zd])
+
+
+def _configure(m, newton: bool, compiled: bool) -> None:
+    m.multiplier_newton = newton
+    cardan_compiled.AVAILABLE = compiled and cardan_compiled.numba is not None
+
+
+def time_variants(m, t, y, runs: int = 40, calls: int = 3) -> dict:
+    times = {label: [] for label, _, _ in VARIANTS}
+    for label, newton, compiled in VARIANTS:      # warm-up (numba compilation, caches)
+        _configure(m, newton, compiled)
+        m.rhs(t, y)
+    for _ in range(runs):
+        for label, newton, compiled in VARIANTS:
+            _configure(m, newton, compiled)
+            t0 = time.thread_time()
+            for _ in range(calls):
+                m.rhs(t, y)
+            times[label].append((time.thread_time() - t0) / calls)
+    return {k: np.array(v) for k, v in times.items()}
+
+
+def profile_groups(m, t, y, calls: int = 40) -> tuple[float, list[tuple[str, float]]]:
+    pr = cProfile.Profile()
+    pr.enable()
+    for _ in range(calls):
+        m.rhs(t, y)
+    pr.disable()
+    st = pstats.Stats(pr)
+    total = 0.0
+    cum: dict[str, float] = {}
+    for (_, _, name), (_, _, _, ct, _) in st.stats.items():
+        cum[name] = cum.get(name, 0.0) + ct
+        if name == "rhs":
+            total = ct
+    rows = []
+    for label, names in GROUPS:
+        rows.append((label, sum(cum.get(n, 0.0) for n in names)))
+    # point effects' "add" is inside mass_force, not inside the element groups: no overlap;
+    # the friction's "values" calls its own small solves, not lu_solve (the KKT's): no overlap
+    rows.append(("rest (state maps, reductions, bookkeeping)", total - sum(v for _, v in rows)))
+    return total, rows
+
+
+def main() -> int:
+    m, t, y = sliding_state()
+    times = time_variants(m, t, y)
+    base = np.min(times[VARIANTS[0][0]])
+    lines = [
+        "# The paper scene's right-hand side: time and where it goes",
+        "",
+        f"Measured {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC on {platform.machine()} "
+        f"({os.cpu_count()} cores), numpy {np.__version__}, OPENBLAS_NUM_THREADS="
+        f"{os.environ.get('OPENBLAS_NUM_THREADS')}; `benchmarks/telescopic_rhs_speed.py`.",
+        "Paper extraction scene, 8 sub-elements (n_dof 313), contact points sliding.  Thread CPU "
+        "time of one `Model.rhs`, 40 interleaved runs of 3 calls.",
+        "",
+        "| variant | min (ms) | median (ms) | speed-up (min) |",
+        "|---|---|---|---|",
+    ]
+    for label, _, _ in VARIANTS:
+        a = times[label] * 1e3
+        lines.append(f"| {label} | {a.min():.1f} | {np.median(a):.1f} | {base * 1e3 / a.min():.2f} |")
+    _configure(m, True, True)
+    total, rows = profile_groups(m, t, y)
+    lines += ["", f"Where the time of `Newton, compiled` goes (cProfile, 40 calls; the profiler "
+              f"adds overhead to every Python call, so shares, not times):", "",
+              "| part | share |", "|---|---|"]
+    for label, v in rows:
+        lines.append(f"| {label} | {100 * v / total:.0f} % |")
+    text = "\n".join(lines) + "\n"
+    print(text)
+    atomic_write_bytes(OUT, text.encode())
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
