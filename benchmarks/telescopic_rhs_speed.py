@@ -10,12 +10,13 @@ random velocity and every contact point sliding (the state of ``jacobian_speed.p
 one ``Model.rhs`` (thread CPU time; minimum and median of 40 runs of 3 calls, the variants
 interleaved so that they share the machine's state) for
 
-* ``fixed point, numpy``  the friction multipliers by fixed-point iteration, numpy section state
-  (the code before 2026-11-24's changes),
-* ``Newton, numpy``       the friction solved by Newton in the four friction values,
-* ``Newton, compiled``    and the section state (Eqs. 24-33) as a compiled numba loop,
+* ``fixed point, numpy``      the friction multipliers by fixed-point iteration, numpy section
+  state, Python micro-motion Newton (the code before 2026-11-24's changes),
+* ``Newton, numpy``           the friction solved by Newton in the four friction values,
+* ``+ compiled section``      and the section state (Eqs. 24-33) as a compiled numba loop,
+* ``+ compiled micro-motion`` and the micro-motion Newton (Eqs. 59-71) compiled too,
 
-then a cProfile of the fastest variant, grouped by what the time is spent on.  Ratios within one
+then a cProfile of the last variant, grouped by what the time is spent on.  Ratios within one
 run are what the table is for; the machine may be shared.
 
 Writes benchmarks/results/telescopic_rhs_speed.md (atomically).
@@ -38,15 +39,17 @@ sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..")
 
 from sim_core import load_scene                               # noqa: E402
 from sim_core.beam import cardan_compiled                     # noqa: E402
+from sim_core.contact import micro_motion_compiled            # noqa: E402
 from sim_core.result import atomic_write_bytes                # noqa: E402
 from sim_core.telescopic import build_telescopic, initial_equilibrium   # noqa: E402
 from sim_core.telescopic_scene import params_from_scene       # noqa: E402
 
 OUT = os.path.join(os.path.dirname(__file__), "results", "telescopic_rhs_speed.md")
 
-# (label, multiplier Newton, compiled section state)
-VARIANTS = (("fixed point, numpy", False, False), ("Newton, numpy", True, False),
-            ("Newton, compiled", True, True))
+# (label, multiplier Newton, compiled section state, compiled micro-motion Newton)
+VARIANTS = (("fixed point, numpy", False, False, False), ("Newton, numpy", True, False, False),
+            ("+ compiled section", True, True, False),
+            ("+ compiled micro-motion", True, True, True))
 
 # cProfile groups: (label, function names whose cumulative time is the group's; nested
 # groups are subtracted from their parents below)
@@ -77,19 +80,20 @@ def sliding_state(n_nodes: int = 9):
     return m, t, np.concatenate([zz, zd])
 
 
-def _configure(m, newton: bool, compiled: bool) -> None:
+def _configure(m, newton: bool, section: bool, micro: bool) -> None:
     m.multiplier_newton = newton
-    cardan_compiled.AVAILABLE = compiled and cardan_compiled.numba is not None
+    cardan_compiled.AVAILABLE = section and cardan_compiled.numba is not None
+    micro_motion_compiled.AVAILABLE = micro and micro_motion_compiled.numba is not None
 
 
 def time_variants(m, t, y, runs: int = 40, calls: int = 3) -> dict:
-    times = {label: [] for label, _, _ in VARIANTS}
-    for label, newton, compiled in VARIANTS:      # warm-up (numba compilation, caches)
-        _configure(m, newton, compiled)
+    times = {v[0]: [] for v in VARIANTS}
+    for label, *flags in VARIANTS:                # warm-up (numba compilation, caches)
+        _configure(m, *flags)
         m.rhs(t, y)
     for _ in range(runs):
-        for label, newton, compiled in VARIANTS:
-            _configure(m, newton, compiled)
+        for label, *flags in VARIANTS:
+            _configure(m, *flags)
             t0 = time.thread_time()
             for _ in range(calls):
                 m.rhs(t, y)
@@ -135,12 +139,12 @@ def main() -> int:
         "| variant | min (ms) | median (ms) | speed-up (min) |",
         "|---|---|---|---|",
     ]
-    for label, _, _ in VARIANTS:
+    for label, *_ in VARIANTS:
         a = times[label] * 1e3
         lines.append(f"| {label} | {a.min():.1f} | {np.median(a):.1f} | {base * 1e3 / a.min():.2f} |")
-    _configure(m, True, True)
+    _configure(m, *VARIANTS[-1][1:])
     total, rows = profile_groups(m, t, y)
-    lines += ["", f"Where the time of `Newton, compiled` goes (cProfile, 40 calls; the profiler "
+    lines += ["", f"Where the time of `{VARIANTS[-1][0]}` goes (cProfile, 40 calls; the profiler "
               f"adds overhead to every Python call, so shares, not times):", "",
               "| part | share |", "|---|---|"]
     for label, v in rows:

@@ -382,6 +382,7 @@ class ContactSolution:
     axial_residual: float
     iterations: int
     tangent: np.ndarray = field(repr=False)
+    newton_floor: np.ndarray | None = field(default=None, repr=False)   # kappa (A^T A + mu Bf^T A)
 
     @property
     def jacobian(self) -> np.ndarray:
@@ -426,9 +427,16 @@ class ContactSolution:
         return -self._load_sensitivity()
 
     def _load_sensitivity(self) -> np.ndarray:
-        """z = J^-T A^T f' (least squares): d sum f / dc = -z."""
+        """z = J^-T A^T f': d sum f / dc = -z.  Solved with the Newton matrix's stiffness floor
+        kappa (it changes z by a relative ~1e-10 and keeps directions that compress no active
+        spring regular); by least squares where the solution carries no floor."""
         g = self.geometry
-        return np.linalg.lstsq(self.jacobian.T, g.AT @ self.tangent, rcond=1e-12)[0]
+        rhs = g.AT @ self.tangent
+        if not rhs.any():
+            return np.zeros(5)              # no spring on its stiff branch: N does not move
+        if self.newton_floor is not None:
+            return np.linalg.solve((self.jacobian + self.newton_floor).T, rhs)
+        return np.linalg.lstsq(self.jacobian.T, rhs, rcond=1e-12)[0]
 
     def aux_gradient(self):
         """Sensitivities of the axial residual (Eq. 72) at this solution.
@@ -532,12 +540,12 @@ def solve_micro_motion(geom: SliderGeometry, spring: SpringLaw, f_c, m_c, mu_val
     load_scale = max(abs(ft), abs(fb), Lr * abs(ms), Lr * abs(mt), Lr * abs(mb))
     fat = spring.force_and_tangent
 
-    def finish(x, delta, f, fp, R, it):
+    def finish(x, delta, f, fp, R, it, floor=None):
         fr = mu * f
         gf = GT @ f                     # (fbar_t, fbar_b, mbar_s, mbar_t, mbar_b), Eq. 66
         f_bar = np.array([-float(fr.sum()), gf[0], gf[1]])
         return ContactSolution(geom, mu, x, delta, f, fr, f_bar, gf[2:5].copy(), R,
-                               fs + float(f_bar[0]), it, fp)  # aux: Eq. 72
+                               fs + float(f_bar[0]), it, fp, floor)  # aux: Eq. 72
 
     if load_scale == 0.0:
         # zero load: every x with all delta <= 0 solves Eqs. 67-71; return the rest position
@@ -564,7 +572,7 @@ def solve_micro_motion(geom: SliderGeometry, spring: SpringLaw, f_c, m_c, mu_val
         f, fp = fat(delta)
         R = c5 + GT @ f
         if status == 0:
-            return finish(x, delta, f, fp, R, it)
+            return finish(x, delta, f, fp, R, it, kappa_GA)
         reason = {1: "singular Newton matrix",
                   2: f"line search failed (|S R| = {err:.3e}, tol {tol:.3e})",
                   3: f"no convergence in {max_iter} Newton iterations "
@@ -578,12 +586,12 @@ def solve_micro_motion(geom: SliderGeometry, spring: SpringLaw, f_c, m_c, mu_val
     row_scale = None
     for it in range(max_iter + 1):
         if err <= tol:
-            return finish(x, delta, f, fp, R, it)
+            return finish(x, delta, f, fp, R, it, kappa_GA)
         if row_scale is None:
             row_scale = float(np.max(np.abs(S[:, None] * GT)))
         floor = 64.0 * _EPS * (row_scale * float(f.sum()) + load_scale)   # round-off of the sums
         if err <= floor:
-            return finish(x, delta, f, fp, R, it)
+            return finish(x, delta, f, fp, R, it, kappa_GA)
         if it == max_iter:
             break
         # Newton step on Eqs. 67-71: J = G^T diag(f') A, stiffness floor kappa in the matrix only
@@ -607,7 +615,7 @@ def solve_micro_motion(geom: SliderGeometry, spring: SpringLaw, f_c, m_c, mu_val
             s *= 0.5
         else:
             if err <= 1e3 * floor:
-                return finish(x, delta, f, fp, R, it)
+                return finish(x, delta, f, fp, R, it, kappa_GA)
             raise ContactSolveError(f"line search failed (|S R| = {err:.3e}, tol {tol:.3e})",
                                     t=t, iterations=it, residual=R, last_x=x)
         x, delta, f, fp, R, SR, phi = x_n, delta_n, f_n, fp_n, R_n, SR_n, phi_n
