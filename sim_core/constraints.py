@@ -23,6 +23,8 @@ from typing import Callable
 
 import numpy as np
 
+from .beam import point_compiled
+
 Vec = np.ndarray
 
 
@@ -157,25 +159,31 @@ def material_point(model, ibeam: int, s_fixed: float | None = None, s_index: int
         e = model._element_at(ibeam, Q.real, float(np.real(s)))
         idx = off + beam.index_map[e]
         el = beam.elements[e]
-        kin = el.evaluate(Q[idx], s=np.array([s]), strains=False)
-        J = np.zeros((3, N), dtype=kin.J_r.dtype)
-        Jp = np.zeros((3, N), dtype=kin.J_r.dtype)
-        J[:, idx] = kin.J_r[0]
-        Jp[:, idx] = kin.J_psi[0]
+        if point_compiled.AVAILABLE:                      # the same kinematics, compiled
+            r, rp, J_r, J_psi, angles, psi_prime, frame, tmat = point_compiled.point_kinematics(
+                el, Q[idx], s)
+        else:
+            kin = el.evaluate(Q[idx], s=np.array([s]), strains=False)
+            r, rp, J_r, J_psi = kin.r[0], kin.rp[0], kin.J_r[0], kin.J_psi[0]
+            sec = kin.sec
+            angles, psi_prime, frame, tmat = (sec.angles[0], sec.psi_prime[0], sec.frame[0],
+                                              sec.tmat[0])
+        J = np.zeros((3, N), dtype=J_r.dtype)
+        Jp = np.zeros((3, N), dtype=J_r.dtype)
+        J[:, idx] = J_r
+        Jp[:, idx] = J_psi
         if s_index is not None:
-            J[:, s_index] += kin.rp[0]
-            Jp[:, s_index] += kin.sec.psi_prime[0]
-        r = kin.r[0]
-        if o_sec is not None:
-            frame = kin.sec.frame[0]                      # rows e_t, e_b, e_s (global)
+            J[:, s_index] += rp
+            Jp[:, s_index] += psi_prime
+        if o_sec is not None:                             # frame: rows e_t, e_b, e_s (global)
             o = o_sec[1] * frame[0] + o_sec[2] * frame[1] + o_sec[0] * frame[2]
             # small global rotation per dQ; tmat gives section components ordered (s, t, b)
-            rot = frame[[2, 0, 1]].T @ (kin.sec.tmat[0] @ Jp)
+            rot = frame[[2, 0, 1]].T @ (tmat @ Jp)
             J = J + np.stack([rot[1] * o[2] - rot[2] * o[1],      # delta_phi x o
                               rot[2] * o[0] - rot[0] * o[2],
                               rot[0] * o[1] - rot[1] * o[0]])
             r = r + o
-        return r, J, kin.sec.angles[0], Jp
+        return r, J, angles, Jp
 
     def coords(Q):
         """The coordinates r and Psi depend on at Q: the element's, and s_index if moving."""

@@ -1,0 +1,122 @@
+"""Compiled (numba) kinematics of one material point of a spline element.
+
+Constraint rows, ropes and contact sections evaluate single points of the booms (a contact
+point, a pivot, a rope anchor) several times per right-hand side, for the real state and for
+the complex-step state of the quadratic velocity terms: ~30 point evaluations per telescopic
+right-hand side, each ~100 small numpy operations through ``SplineElement.evaluate`` (over a
+third of the right-hand side at 8 sub-elements in a run, py-spy).  This is the same algebra for
+one point as one compiled function: the spline basis rows at xi (Eqs. 5, 10-11, Appendix A
+tables), r and its derivatives, the section state (Eqs. 24-33, :mod:`cardan_compiled`), the
+material Jacobians J_r = dr/dQ|_s and J_psi = d(alpha, beta, gamma)/dQ|_s.
+``SplineElement.evaluate`` stays the reference; ``tests/beam/test_point_compiled.py`` checks
+that both agree for real and complex-step states.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import cardan_compiled
+
+AVAILABLE = cardan_compiled.AVAILABLE
+
+
+def _point(qe, s, n, D_all, pow_p, pow_t, basis, i_s1):
+    """(r, rp, J_r (3, nq), J_psi (3, nq), angles, psi_prime, frame, tmat) at material s."""
+    dt = qe.dtype
+    na = n + 4
+    npos = 3 * na
+    nq = qe.shape[0]
+    s1 = qe[i_s1]
+    sn = qe[i_s1 + 1]
+    ell = (sn - s1) / (n - 1)                                        # Eq. 5
+    sub = int(np.floor((s.real - s1.real) / ell.real))               # SplineElement.locate
+    sub = min(max(sub, 0), n - 2)
+    xi = (s - s1) / ell - sub                                        # Eq. 10
+    nrow = D_all.shape[2]
+    rows = np.zeros(nrow, dtype=dt)
+    p_xi = 1.0 + 0.0 * xi
+    for p in range(6):                                               # sum_p xi^p D[sub, p]
+        for k in range(nrow):
+            rows[k] += p_xi * D_all[sub, p, k]
+        p_xi = p_xi * xi
+    il = 1.0 / ell
+    il2 = il * il
+    lpow = np.empty(7, dtype=dt)
+    lpow[0] = il2 * il2
+    lpow[1] = il2 * il
+    lpow[2] = il2
+    lpow[3] = il
+    lpow[4] = 1.0
+    lpow[5] = ell
+    lpow[6] = ell * ell
+    X = np.empty((7, na), dtype=dt)
+    for i in range(7):
+        for a in range(na):
+            X[i, a] = rows[i * na + a] * lpow[pow_p[i, a]]
+    Y = np.empty((5, 2 * n), dtype=dt)
+    off = 7 * na
+    for i in range(5):
+        for a in range(2 * n):
+            Y[i, a] = rows[off + i * 2 * n + a] * lpow[pow_t[i, a]]
+    RR = np.zeros((7, 3), dtype=dt)                                  # r, r', r'', r''', d/dl
+    for i in range(7):
+        for a in range(na):
+            for j in range(3):
+                RR[i, j] += X[i, a] * qe[3 * a + j]
+    TT = np.zeros(5, dtype=dt)                                       # gamma, gamma', ...
+    for i in range(5):
+        for a in range(2 * n):
+            TT[i] += Y[i, a] * qe[npos + a]
+    frac = (sub + xi) / (n - 1)
+    ds0, ds1 = 1.0 - frac, frac                                      # ds/d(s_1, s_n) at xi
+    dl0, dl1 = -1.0 / (n - 1), 1.0 / (n - 1)                         # dl/d(s_1, s_n)
+
+    rp = RR[1:2].copy()
+    rpp = RR[2:3].copy()
+    gam = TT[0:1].copy()
+    gamp = TT[1:2].copy()
+    eps = np.empty((1, 4), dtype=dt)
+    d = np.empty((1, 4, 8), dtype=dt)
+    dpsi = np.empty((1, 2, 3), dtype=dt)
+    tmat = np.empty((1, 3, 3), dtype=dt)
+    frame = np.empty((1, 3, 3), dtype=dt)
+    angles = np.empty((1, 3), dtype=dt)
+    psi_prime = np.empty((1, 3), dtype=dt)
+    cardan_compiled._compiled(rp, rpp, gam, gamp, basis, eps, d, dpsi, tmat, frame, angles,
+                              psi_prime)
+
+    J_r = np.zeros((3, nq), dtype=dt)
+    for j in range(3):
+        for a in range(na):
+            J_r[j, 3 * a + j] = X[0, a]
+        J_r[j, i_s1] = RR[4, j] * dl0 - RR[1, j] * ds0
+        J_r[j, i_s1 + 1] = RR[4, j] * dl1 - RR[1, j] * ds1
+    J_psi = np.zeros((3, nq), dtype=dt)
+    for i in range(2):
+        for a in range(na):
+            for j in range(3):
+                J_psi[i, 3 * a + j] = dpsi[0, i, j] * X[1, a]
+        # d(alpha, beta)/dl at fixed xi and (alpha, beta)' from dr'/dl and r''
+        c_l = dpsi[0, i, 0] * RR[5, 0] + dpsi[0, i, 1] * RR[5, 1] + dpsi[0, i, 2] * RR[5, 2]
+        c_s = dpsi[0, i, 0] * RR[2, 0] + dpsi[0, i, 1] * RR[2, 1] + dpsi[0, i, 2] * RR[2, 2]
+        J_psi[i, i_s1] = c_l * dl0 - c_s * ds0
+        J_psi[i, i_s1 + 1] = c_l * dl1 - c_s * ds1
+    for a in range(2 * n):
+        J_psi[2, npos + a] = Y[0, a]
+    J_psi[2, i_s1] = TT[3] * dl0 - TT[1] * ds0
+    J_psi[2, i_s1 + 1] = TT[3] * dl1 - TT[1] * ds1
+    return (RR[0].copy(), RR[1].copy(), J_r, J_psi, angles[0].copy(), psi_prime[0].copy(),
+            frame[0].copy(), tmat[0].copy())
+
+
+if AVAILABLE:
+    _compiled_point = cardan_compiled.numba.njit(cache=True, nogil=True)(_point)
+
+
+def point_kinematics(el, qe, s):
+    """(r, r', J_r, J_psi, (alpha, beta, gamma), psi', frame, tmat) of element ``el`` at the
+    material coordinate s (real or complex-step; qe real or complex)."""
+    dt = np.result_type(qe, s, float)
+    qe = np.ascontiguousarray(qe, dtype=dt)
+    return _compiled_point(qe, dt.type(s), el.n, el._D_all, el._pow_p, el._pow_t, el.G, el.i_s1)
