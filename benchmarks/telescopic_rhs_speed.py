@@ -7,14 +7,18 @@ One command (from the repository root):
 The paper's extraction scene (25 t, friction with the slider-spring distribution, stress filter,
 elastic ropes) at 8 sub-elements per spline element, at the static equilibrium with a small
 random velocity and every contact point sliding (the state of ``jacobian_speed.py``).  It times
-one ``Model.rhs`` (thread CPU time; minimum and median of 40 runs of 3 calls, the variants
-interleaved so that they share the machine's state) for
+one ``Model.rhs`` (thread CPU time; minimum and median of 40 runs of 4 calls, the variants
+interleaved so that they share the machine's state).  Every call gets a state of its own (the
+base state with a relative perturbation of 1e-9), as in a run: the point functions keep their
+last evaluation, and a benchmark that repeats one state measures cache hits.  Variants:
 
 * ``fixed point, numpy``      the friction multipliers by fixed-point iteration, numpy section
   state, Python micro-motion Newton (the code before 2026-11-24's changes),
 * ``Newton, numpy``           the friction solved by Newton in the four friction values,
 * ``+ compiled section``      and the section state (Eqs. 24-33) as a compiled numba loop,
 * ``+ compiled micro-motion`` and the micro-motion Newton (Eqs. 59-71) compiled too,
+* ``+ compiled points``       and the one-point kinematics of the constraint, rope and contact
+  points (``sim_core.beam.point_compiled``),
 
 then a cProfile of the last variant, grouped by what the time is spent on.  Ratios within one
 run are what the table is for; the machine may be shared.
@@ -38,7 +42,7 @@ import numpy as np
 sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..")))
 
 from sim_core import load_scene                               # noqa: E402
-from sim_core.beam import cardan_compiled                     # noqa: E402
+from sim_core.beam import cardan_compiled, point_compiled     # noqa: E402
 from sim_core.contact import micro_motion_compiled            # noqa: E402
 from sim_core.result import atomic_write_bytes                # noqa: E402
 from sim_core.telescopic import build_telescopic, initial_equilibrium   # noqa: E402
@@ -46,15 +50,17 @@ from sim_core.telescopic_scene import params_from_scene       # noqa: E402
 
 OUT = os.path.join(os.path.dirname(__file__), "results", "telescopic_rhs_speed.md")
 
-# (label, multiplier Newton, compiled section state, compiled micro-motion Newton)
-VARIANTS = (("fixed point, numpy", False, False, False), ("Newton, numpy", True, False, False),
-            ("+ compiled section", True, True, False),
-            ("+ compiled micro-motion", True, True, True))
+# (label, multiplier Newton, compiled section state, micro-motion Newton, point kinematics)
+VARIANTS = (("fixed point, numpy", False, False, False, False),
+            ("Newton, numpy", True, False, False, False),
+            ("+ compiled section", True, True, False, False),
+            ("+ compiled micro-motion", True, True, True, False),
+            ("+ compiled points", True, True, True, True))
 
 # cProfile groups: (label, function names whose cumulative time is the group's; nested
 # groups are subtracted from their parents below)
 GROUPS = (
-    ("friction (micro-motion solves, sensitivities)", ("values",)),
+    ("friction (section maps, micro-motion solves, sensitivities)", ("at_state", "values")),
     ("constraint rows (Jacobian, quadratic terms)", ("constraint_terms",)),
     ("saddle-point factorisation", ("kkt_factor",)),
     ("saddle-point solves", ("lu_solve",)),
@@ -80,32 +86,43 @@ def sliding_state(n_nodes: int = 9):
     return m, t, np.concatenate([zz, zd])
 
 
-def _configure(m, newton: bool, section: bool, micro: bool) -> None:
+def _configure(m, newton: bool, section: bool, micro: bool, points: bool) -> None:
     m.multiplier_newton = newton
     cardan_compiled.AVAILABLE = section and cardan_compiled.numba is not None
     micro_motion_compiled.AVAILABLE = micro and micro_motion_compiled.numba is not None
+    point_compiled.AVAILABLE = points and cardan_compiled.numba is not None
 
 
-def time_variants(m, t, y, runs: int = 40, calls: int = 3) -> dict:
+def states(y, count: int, seed: int = 1):
+    """``count`` states near y (relative perturbation 1e-9): no call repeats a state."""
+    rng = np.random.default_rng(seed)
+    return [y * (1.0 + 1e-9 * rng.standard_normal(len(y))) for _ in range(count)]
+
+
+def time_variants(m, t, y, runs: int = 40, calls: int = 4) -> dict:
     times = {v[0]: [] for v in VARIANTS}
     for label, *flags in VARIANTS:                # warm-up (numba compilation, caches)
         _configure(m, *flags)
         m.rhs(t, y)
+    ys = states(y, runs * len(VARIANTS) * calls)
+    k = 0
     for _ in range(runs):
         for label, *flags in VARIANTS:
             _configure(m, *flags)
             t0 = time.thread_time()
             for _ in range(calls):
-                m.rhs(t, y)
+                m.rhs(t, ys[k])
+                k += 1
             times[label].append((time.thread_time() - t0) / calls)
     return {k: np.array(v) for k, v in times.items()}
 
 
 def profile_groups(m, t, y, calls: int = 40) -> tuple[float, list[tuple[str, float]]]:
+    ys = states(y, calls, seed=2)
     pr = cProfile.Profile()
     pr.enable()
-    for _ in range(calls):
-        m.rhs(t, y)
+    for yk in ys:
+        m.rhs(t, yk)
     pr.disable()
     st = pstats.Stats(pr)
     total = 0.0
@@ -134,7 +151,8 @@ def main() -> int:
         f"({os.cpu_count()} cores), numpy {np.__version__}, OPENBLAS_NUM_THREADS="
         f"{os.environ.get('OPENBLAS_NUM_THREADS')}; `benchmarks/telescopic_rhs_speed.py`.",
         "Paper extraction scene, 8 sub-elements (n_dof 313), contact points sliding.  Thread CPU "
-        "time of one `Model.rhs`, 40 interleaved runs of 3 calls.",
+        "time of one `Model.rhs`, 40 interleaved runs of 4 calls, each call at a state of its "
+        "own.",
         "",
         "| variant | min (ms) | median (ms) | speed-up (min) |",
         "|---|---|---|---|",
