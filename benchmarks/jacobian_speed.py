@@ -60,7 +60,9 @@ def whole_rhs_jacobian(model, t, y):
     return J
 
 
-def row(n_nodes: int):
+def sliding_state(n_nodes: int):
+    """(model, t, y) of the paper's extraction scene at its static equilibrium with a small random
+    velocity and every contact point sliding (boom 2 at 0.1 m/s in boom 1, boom 3 in boom 2)."""
     p = params_from_scene(load_scene("telescopic_extraction"))
     p.n_nodes = n_nodes
     ts = build_telescopic(p)
@@ -74,7 +76,11 @@ def row(n_nodes: int):
     for i in ts.s3_index[1:]:
         Qd[i] = -0.1
     zz, zd = m.reduced_state(t, Q, Qd)
-    y = np.concatenate([zz, zd])
+    return m, t, np.concatenate([zz, zd])
+
+
+def row(n_nodes: int):
+    m, t, y = sliding_state(n_nodes)
     n = m.n_dof
     t_rhs, _ = _best(lambda: m.rhs(t, y), 5)
     t_struct, (J, cost) = _best(lambda: state_jacobian(m, t, y, return_cost=True), 3)

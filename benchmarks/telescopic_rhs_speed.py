@@ -41,12 +41,10 @@ import numpy as np
 
 sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..")))
 
-from sim_core import load_scene                               # noqa: E402
 from sim_core.beam import cardan_compiled, point_compiled     # noqa: E402
 from sim_core.contact import micro_motion_compiled            # noqa: E402
 from sim_core.result import atomic_write_bytes                # noqa: E402
-from sim_core.telescopic import build_telescopic, initial_equilibrium   # noqa: E402
-from sim_core.telescopic_scene import params_from_scene       # noqa: E402
+from jacobian_speed import sliding_state                      # noqa: E402  (benchmarks/)
 
 OUT = os.path.join(os.path.dirname(__file__), "results", "telescopic_rhs_speed.md")
 
@@ -67,23 +65,6 @@ GROUPS = (
     ("point effects (payload, ropes)", ("add",)),
     ("elements (kinematics, mass, forces)", ("element_contexts", "element_mass_force")),
 )
-
-
-def sliding_state(n_nodes: int = 9):
-    p = params_from_scene(load_scene("telescopic_extraction"))
-    p.n_nodes = n_nodes
-    ts = build_telescopic(p)
-    m = ts.model
-    z, _ = initial_equilibrium(ts)
-    t = 3.0
-    rng = np.random.default_rng(0)
-    Q, Qd = m.full_state(t, z, 1e-3 * rng.standard_normal(len(z)))
-    for i in ts.s2_index:
-        Qd[i] = 0.1
-    for i in ts.s3_index[1:]:
-        Qd[i] = -0.1
-    zz, zd = m.reduced_state(t, Q, Qd)
-    return m, t, np.concatenate([zz, zd])
 
 
 def _configure(m, newton: bool, section: bool, micro: bool, points: bool) -> None:
@@ -141,7 +122,7 @@ def profile_groups(m, t, y, calls: int = 40) -> tuple[float, list[tuple[str, flo
 
 
 def main() -> int:
-    m, t, y = sliding_state()
+    m, t, y = sliding_state(9)
     times = time_variants(m, t, y)
     base = np.min(times[VARIANTS[0][0]])
     lines = [

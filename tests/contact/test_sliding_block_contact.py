@@ -532,16 +532,21 @@ def test_warm_start_and_typed_failure():
     assert math.isnan(exc.value.t)
 
 
-def test_random_loads_converge():
-    """Random loads over ten decades, both regions, |mu| <= 0.15: all converge (bounded count)."""
-    rng = np.random.default_rng(7)
+def random_loads(seed: int, count: int):
+    """(geometry, f_c, m_c, mu): loads over ten decades, moments 0.01-1 of the force times 1 m,
+    both regions of pairs 1 and 2, |mu| <= 0.15."""
+    rng = np.random.default_rng(seed)
     geoms = [region(p, k) for p in (1, 2) for k in ("inner", "outer")]
-    for i in range(200):
-        g = geoms[i % 4]
+    for i in range(count):
         mag = 10 ** rng.uniform(-2, 7)
         f_c = rng.normal(size=3) * mag
         m_c = rng.normal(size=3) * mag * 10 ** rng.uniform(-2, 0)
-        mu = rng.uniform(-0.15, 0.15)
+        yield geoms[i % 4], f_c, m_c, rng.uniform(-0.15, 0.15)
+
+
+def test_random_loads_converge():
+    """Random loads over ten decades, both regions, |mu| <= 0.15: all converge (bounded count)."""
+    for g, f_c, m_c, mu in random_loads(7, 200):
         sol = solve_micro_motion(g, SPRING, f_c, m_c, mu)
         Lr = 1.0 / g.length_scale
         r = np.abs(sol.residual * np.array([1, 1, Lr, Lr, Lr])).max()
@@ -555,14 +560,7 @@ def test_compiled_newton_equals_the_python_loop(monkeypatch):
     steps: over random loads (ten decades, both regions, cold and warm starts) the same
     iteration counts and solutions within 1e-9 of the largest micro-motion (round-off in the
     order of the sums, amplified by the Newton solves); the same typed failure."""
-    rng = np.random.default_rng(11)
-    geoms = [region(p, k) for p in (1, 2) for k in ("inner", "outer")]
-    for i in range(100):
-        g = geoms[i % 4]
-        mag = 10 ** rng.uniform(-2, 7)
-        f_c = rng.normal(size=3) * mag
-        m_c = rng.normal(size=3) * mag * 10 ** rng.uniform(-2, 0)
-        mu = rng.uniform(-0.15, 0.15)
+    for g, f_c, m_c, mu in random_loads(11, 100):
         out = []
         for compiled in (True, False):
             monkeypatch.setattr(micro_motion_compiled, "AVAILABLE", compiled)
