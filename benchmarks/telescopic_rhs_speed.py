@@ -29,7 +29,6 @@ Writes benchmarks/results/telescopic_rhs_speed.md (atomically).
 from __future__ import annotations
 
 import cProfile
-import io
 import os
 import platform
 import pstats
