@@ -15,6 +15,7 @@ from typing import Callable, Sequence
 import numpy as np
 import scipy.linalg as sla
 
+from .beam import element_compiled
 from .beam.moving_node_beam import Beam
 from .constraints import constraint_terms, kkt_accelerations, kkt_factor
 from .effects import Effect, ElementContext, PointLoad
@@ -145,16 +146,45 @@ class Model:
             eff.element_terms(ctx, Me, Fe)
         return Me, Fe
 
+    def element_terms(self, t: float, el, qe: np.ndarray, qde: np.ndarray, mass: bool = True,
+                      kin=None):
+        """Element mass matrix (or None) and force vector at (qe, qde): the compiled kernel of
+        :mod:`sim_core.beam.element_compiled` where it covers the model's effects (Inertia,
+        Elasticity, StressFilter, Gravity; no mass-centre offset; real states), otherwise
+        ``element_mass_force(element_context(...))`` (the reference; ``kin``: the
+        position-level kinematics at qe, if already at hand)."""
+        kw = self._compiled_effects(el.section) if element_compiled.AVAILABLE else None
+        if kw is not None and not (np.iscomplexobj(qe) or np.iscomplexobj(qde)):
+            return element_compiled.element_mass_force(el, qe, qde, needs_mass=mass, **kw)
+        return self.element_mass_force(self.element_context(t, el, qe, qde, kin), mass)
+
+    def _compiled_effects(self, section):
+        """element_compiled's effect arguments for this section (read from the effects at
+        every call: statics scale the gravity of an effect in place), or None where the kernel
+        does not cover the effects (that verdict is kept per section and effect list)."""
+        key = (id(section), tuple(id(e) for e in self.effects))
+        covered = self.__dict__.setdefault("_compiled_covered", {})
+        if covered.get(key) is False:
+            return None
+        try:
+            kw = element_compiled.effect_parameters(self.effects, section)
+        except ValueError:
+            kw = None
+        covered[key] = kw is not None
+        return kw
+
     def mass_force(self, t: float, Q: np.ndarray, Qd: np.ndarray, mass: bool = True):
         """Full-coordinate mass matrix (or None) and force vector: M Q_ddot = F."""
         N = self.n_coords
         M = np.zeros((N, N)) if mass else None
         F = np.zeros(N)
-        for idx, ctx in self.element_contexts(t, Q, Qd):
-            Me, Fe = self.element_mass_force(ctx, mass)
-            if mass:
-                M[np.ix_(idx, idx)] += Me
-            np.add.at(F, idx, Fe)
+        for b, off in zip(self.beams, self.offsets):
+            for el, imap in zip(b.elements, b.index_map):
+                idx = off + imap
+                Me, Fe = self.element_terms(t, el, Q[idx], Qd[idx], mass)
+                if mass:
+                    M[np.ix_(idx, idx)] += Me
+                np.add.at(F, idx, Fe)
         for pl in self.point_loads:
             self._add_point_load(pl, t, Q, F)
         for pe in self.point_effects:

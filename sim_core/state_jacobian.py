@@ -82,22 +82,22 @@ def state_jacobian(model, t: float, y: np.ndarray, rel_step: float = REL_STEP,
     el_evals = 0
 
     # elements: F_e(q_e, qd_e) - M_e(q_e) qdd_e in the element's own coordinates; the rate
-    # columns reuse the position-level kinematics and skip the mass matrix (M_e does not depend
-    # on rates)
+    # columns skip the mass matrix (M_e does not depend on rates), and on the numpy path reuse
+    # the position-level kinematics
     for b, off in zip(model.beams, model.offsets):
         for el, imap in zip(b.elements, b.index_map):
             idx = off + imap
             qdde = Qdd[idx]
             qe, qde = Q[idx].copy(), Qd[idx].copy()
-            ctx0 = model.element_context(t, el, qe, qde)
+            kin0 = el.evaluate(qe, strains="strains" in model.needs,
+                               material_strain="material_strain" in model.needs)
 
             def by_position(el=el, qe=qe, qde=qde, qdde=qdde):
-                Me, Fe = model.element_mass_force(model.element_context(t, el, qe, qde))
+                Me, Fe = model.element_terms(t, el, qe, qde)
                 return Fe - Me @ qdde
 
-            def by_rate(el=el, qe=qe, qde=qde, kin=ctx0.kin):
-                return model.element_mass_force(model.element_context(t, el, qe, qde, kin),
-                                                mass=False)[1]
+            def by_rate(el=el, qe=qe, qde=qde, kin=kin0):
+                return model.element_terms(t, el, qe, qde, mass=False, kin=kin)[1]
 
             cols = np.arange(len(idx))
             dR1[np.ix_(idx, idx)] += _difference(by_position, qe, cols, rel_step, central)

@@ -1,0 +1,522 @@
+"""Compiled (numba) element mass matrix and force vector of the telescopic effect set.
+
+``Model.element_mass_force(Model.element_context(t, el, qe, qde))`` with the effects Inertia
+(mass centre on the reference line, y_c = z_c = 0), Elasticity, StressFilter(h) and Gravity(g)
+of :mod:`sim_core.effects` costs ~100 small numpy operations per element (a real
+``SplineElement.evaluate``, a complex-step one for the convective terms, the lazily formed
+Jacobians J_r, J_w, B_xi, B_s and the effect sums; ~1.2 ms at 9 nodes, 40 Gauss points, 59
+coordinates).  This is the same algebra as one compiled pass over the quadrature points:
+
+* kinematics at the Gauss points (Zhao, Qi, Wang (2024), Sections 3-5): spline basis rows with
+  the powers of the sub-element length l (Eqs. 5, 10-11, cached tables of the element), r and
+  its s-derivatives, the section state (Eqs. 24-33, the compiled kernel of
+  :mod:`cardan_compiled`), the material Jacobians at fixed s: J_r = dr/dQ|_s, the angular
+  velocity Jacobian J_w = T dpsi/dQ|_s (Eqs. 30-31) and the strain Jacobians B_xi (fixed xi)
+  and B_s (fixed s, material);
+* convective terms (J_r)^. q_dot, (J_w)^. q_dot, (B_s)^. q_dot at fixed s by complex-step
+  differentiation (as ``Model.element_context``: state qe + i h qde, the same material points
+  s, whose xi then carries the perturbation), contracted with q_dot without forming the complex
+  Jacobians; the same :mod:`cardan_compiled` kernel compiled for complex128;
+* virtual power of the effects (Eq. 34): inertia M += int rhoA J_r^T J_r + J_w^T J J_w ds,
+  F -= int rhoA J_r^T a + J_w^T (J w_dot + omega x J omega) ds; elastic force as the gradient
+  of the strain energy (Eqs. 35-36: F -= sum w [l B_xi^T D eps + W dl/dQ]); the stress filter of
+  the second seed (Eq. 53): M += (h^2/6) int B_s^T D B_s ds, F -= int B_s^T D ((h/2) eps_dot +
+  (h^2/6) (B_s)^. q_dot) ds; gravity F += int rhoA J_r^T g ds.
+
+The mass matrix is one BLAS product A^T A of the weighted Jacobian rows of all points stacked
+into a (G k, n_coords) matrix (k = 6 for inertia, + 4 for the filter), the force one
+matrix-vector product of the stacked unweighted rows (J_r, J_w, B_s) with the per-row loads.
+
+The numpy path (``Model.element_mass_force``) stays the reference and the fallback where numba
+is not installed (``AVAILABLE`` is False then); ``tests/beam/test_element_compiled.py`` checks
+that both agree to round-off.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import cardan_compiled
+
+AVAILABLE = cardan_compiled.AVAILABLE
+
+_CSTEP = 1e-20      # complex-step size, as sim_core.model._CSTEP
+
+
+def _centre_line(qe, X, Y, n, basis):
+    """RR (G, 7, 3): r, r', r'', r''' and d/dl at fixed xi of r, r', r''; TT (G, 5): gamma,
+    gamma', gamma'' and d/dl of gamma, gamma'; and the section state of cardan_compiled."""
+    G = X.shape[0]
+    na = n + 4
+    npos = 3 * na
+    nt = 2 * n
+    dt = X.dtype
+    RR = np.zeros((G, 7, 3), dtype=dt)
+    TT = np.zeros((G, 5), dtype=dt)
+    for g in range(G):
+        for i in range(7):
+            r0 = RR[g, i, 0]
+            r1 = RR[g, i, 1]
+            r2 = RR[g, i, 2]
+            for a in range(na):
+                x = X[g, i, a]
+                r0 += x * qe[3 * a]
+                r1 += x * qe[3 * a + 1]
+                r2 += x * qe[3 * a + 2]
+            RR[g, i, 0] = r0
+            RR[g, i, 1] = r1
+            RR[g, i, 2] = r2
+        for i in range(5):
+            acc = TT[g, i]
+            for a in range(nt):
+                acc += Y[g, i, a] * qe[npos + a]
+            TT[g, i] = acc
+    rp = np.empty((G, 3), dtype=dt)
+    rpp = np.empty((G, 3), dtype=dt)
+    gam = np.empty(G, dtype=dt)
+    gamp = np.empty(G, dtype=dt)
+    for g in range(G):
+        for j in range(3):
+            rp[g, j] = RR[g, 1, j]
+            rpp[g, j] = RR[g, 2, j]
+        gam[g] = TT[g, 0]
+        gamp[g] = TT[g, 1]
+    eps = np.empty((G, 4), dtype=dt)
+    d = np.empty((G, 4, 8), dtype=dt)
+    dpsi = np.empty((G, 2, 3), dtype=dt)
+    tmat = np.empty((G, 3, 3), dtype=dt)
+    frame = np.empty((G, 3, 3), dtype=dt)
+    angles = np.empty((G, 3), dtype=dt)
+    psi_prime = np.empty((G, 3), dtype=dt)
+    cardan_compiled._compiled(rp, rpp, gam, gamp, basis, eps, d, dpsi, tmat, frame, angles,
+                              psi_prime)
+    return RR, TT, eps, d, dpsi, tmat
+
+
+def _convective(qe, qde, cstep, n, D_all, q_pos, q_sub, pow_p, pow_t, basis, i_s1,
+                with_strain):
+    """Material convective terms at the Gauss points (Model.element_context):
+    a = (J_r)^. q_dot (G, 3), w_dot = (J_w)^. q_dot (G, 3), eps_ddot = (B_s)^. q_dot (G, 4)
+    (zeros unless with_strain), by complex step in q along q_dot at the fixed material s."""
+    G = q_pos.shape[0]
+    na = n + 4
+    npos = 3 * na
+    nt = 2 * n
+    nq = qe.shape[0]
+    qc = np.empty(nq, dtype=np.complex128)
+    for k in range(nq):
+        qc[k] = qe[k] + 1j * (cstep * qde[k])
+    s1r = qe[i_s1]
+    ellr = (qe[i_s1 + 1] - s1r) / (n - 1)
+    s1 = qc[i_s1]
+    ell = (qc[i_s1 + 1] - s1) / (n - 1)                               # Eq. 5
+    il = 1.0 / ell
+    il2 = il * il
+    lpow = np.empty(7, dtype=np.complex128)
+    lpow[0] = il2 * il2
+    lpow[1] = il2 * il
+    lpow[2] = il2
+    lpow[3] = il
+    lpow[4] = 1.0
+    lpow[5] = ell
+    lpow[6] = ell * ell
+    nrow = D_all.shape[2]
+    X = np.empty((G, 7, na), dtype=np.complex128)
+    Y = np.empty((G, 5, nt), dtype=np.complex128)
+    ds = np.empty((G, 2), dtype=np.complex128)
+    rre = np.empty(nrow)                 # basis rows sum_p xi^p D[sub, p] (D real): real and
+    rim = np.empty(nrow)                 # imaginary parts as two real sums
+    for g in range(G):
+        sub = q_sub[g]
+        s = s1r + q_pos[g] * ellr                                     # the real material point
+        xi = (s - s1) / ell - sub                                     # Eq. 10, complex
+        rre[:] = 0.0
+        rim[:] = 0.0
+        p_xi = 1.0 + 0.0j
+        for p in range(6):
+            pr = p_xi.real
+            pi = p_xi.imag
+            for k in range(nrow):
+                dk = D_all[sub, p, k]
+                rre[k] += pr * dk
+                rim[k] += pi * dk
+            p_xi = p_xi * xi
+        for i in range(7):
+            for a in range(na):
+                k = i * na + a
+                X[g, i, a] = (rre[k] + 1j * rim[k]) * lpow[pow_p[i, a]]
+        off = 7 * na
+        for i in range(5):
+            for a in range(nt):
+                k = off + i * nt + a
+                Y[g, i, a] = (rre[k] + 1j * rim[k]) * lpow[pow_t[i, a]]
+        frac = (sub + xi) / (n - 1)
+        ds[g, 0] = 1.0 - frac
+        ds[g, 1] = frac
+    RR, TT, eps, d, dpsi, tmat = _centre_line(qc, X, Y, n, basis)
+    dl0 = -1.0 / (n - 1)
+    dl1 = 1.0 / (n - 1)
+    qs0 = qde[i_s1]
+    qs1 = qde[i_s1 + 1]
+    a_out = np.empty((G, 3))
+    w_out = np.empty((G, 3))
+    e_out = np.zeros((G, 4))
+    u0 = np.empty(3, dtype=np.complex128)
+    u1 = np.empty(3, dtype=np.complex128)
+    u2 = np.empty(3, dtype=np.complex128)
+    pdot = np.empty(3, dtype=np.complex128)
+    x_l = np.empty(8, dtype=np.complex128)
+    x_p = np.empty(8, dtype=np.complex128)
+    for g in range(G):
+        u0[:] = 0.0
+        u1[:] = 0.0
+        u2[:] = 0.0
+        for a in range(na):
+            x0 = X[g, 0, a]
+            x1 = X[g, 1, a]
+            x2 = X[g, 2, a]
+            for j in range(3):
+                v = qde[3 * a + j]
+                u0[j] += x0 * v
+                u1[j] += x1 * v
+                u2[j] += x2 * v
+        t0 = 0.0j
+        t1 = 0.0j
+        for a in range(nt):
+            v = qde[npos + a]
+            t0 += Y[g, 0, a] * v
+            t1 += Y[g, 1, a] * v
+        ds0 = ds[g, 0]
+        ds1 = ds[g, 1]
+        for j in range(3):                                            # J_r q_dot
+            acc = (u0[j] + (RR[g, 4, j] * dl0 - RR[g, 1, j] * ds0) * qs0
+                   + (RR[g, 4, j] * dl1 - RR[g, 1, j] * ds1) * qs1)
+            a_out[g, j] = acc.imag / cstep
+        for i in range(2):                                            # (alpha, beta)^. at fixed s
+            c_l = (dpsi[g, i, 0] * RR[g, 5, 0] + dpsi[g, i, 1] * RR[g, 5, 1]
+                   + dpsi[g, i, 2] * RR[g, 5, 2])
+            c_s = (dpsi[g, i, 0] * RR[g, 2, 0] + dpsi[g, i, 1] * RR[g, 2, 1]
+                   + dpsi[g, i, 2] * RR[g, 2, 2])
+            pdot[i] = (dpsi[g, i, 0] * u1[0] + dpsi[g, i, 1] * u1[1] + dpsi[g, i, 2] * u1[2]
+                       + (c_l * dl0 - c_s * ds0) * qs0 + (c_l * dl1 - c_s * ds1) * qs1)
+        pdot[2] = (t0 + (TT[g, 3] * dl0 - TT[g, 1] * ds0) * qs0
+                   + (TT[g, 3] * dl1 - TT[g, 1] * ds1) * qs1)
+        for i in range(3):                                            # J_w q_dot = T psi^.
+            acc = tmat[g, i, 0] * pdot[0] + tmat[g, i, 1] * pdot[1] + tmat[g, i, 2] * pdot[2]
+            w_out[g, i] = acc.imag / cstep
+        if with_strain:                                               # B_s q_dot
+            for j in range(3):
+                x_l[j] = RR[g, 5, j]
+                x_l[3 + j] = RR[g, 6, j]
+                x_p[j] = RR[g, 2, j]
+                x_p[3 + j] = RR[g, 3, j]
+            x_l[6] = TT[g, 3]
+            x_l[7] = TT[g, 4]
+            x_p[6] = TT[g, 1]
+            x_p[7] = TT[g, 2]
+            for r in range(4):
+                cl = 0.0j
+                cp = 0.0j
+                for k in range(8):
+                    cl += d[g, r, k] * x_l[k]
+                    cp += d[g, r, k] * x_p[k]
+                acc = (d[g, r, 0] * u1[0] + d[g, r, 1] * u1[1] + d[g, r, 2] * u1[2]
+                       + d[g, r, 3] * u2[0] + d[g, r, 4] * u2[1] + d[g, r, 5] * u2[2]
+                       + d[g, r, 6] * t0 + d[g, r, 7] * t1
+                       + (cl * dl0 - cp * ds0) * qs0 + (cl * dl1 - cp * ds1) * qs1)
+                e_out[g, r] = acc.imag / cstep
+    return a_out, w_out, e_out
+
+
+def _mass_force(qe, qde, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_sub, D_all, basis,
+                i_s1, rhoA, Jrot, D, h, grav, inertia, elasticity, gravity, needs_mass, cstep):
+    """(Me (nq, nq) or (0, 0), Fe (nq,)) of one element; see element_mass_force."""
+    G = q_phi.shape[0]
+    na = n + 4
+    npos = 3 * na
+    nt = 2 * n
+    nq = qe.shape[0]
+    filt = h > 0.0
+    strains = elasticity or filt
+    s1 = qe[i_s1]
+    ell = (qe[i_s1 + 1] - s1) / (n - 1)                               # Eq. 5
+    il = 1.0 / ell
+    il2 = il * il
+    lpow = np.empty(7)
+    lpow[0] = il2 * il2
+    lpow[1] = il2 * il
+    lpow[2] = il2
+    lpow[3] = il
+    lpow[4] = 1.0
+    lpow[5] = ell
+    lpow[6] = ell * ell
+    X = np.empty((G, 7, na))
+    Y = np.empty((G, 5, nt))
+    for g in range(G):
+        for i in range(7):
+            for a in range(na):
+                X[g, i, a] = q_phi[g, i, a] * lpow[pow_p[i, a]]
+        for i in range(5):
+            for a in range(nt):
+                Y[g, i, a] = q_psi[g, i, a] * lpow[pow_t[i, a]]
+    RR, TT, eps, d, dpsi, tmat = _centre_line(qe, X, Y, n, basis)
+    dl = np.empty(2)
+    dl[0] = -1.0 / (n - 1)
+    dl[1] = 1.0 / (n - 1)
+    wl = np.empty(G)
+    for g in range(G):
+        wl[g] = q_w[g] * ell
+
+    # stacked rows per point: J_r (0:3), J_w (3:6), B_s (6:10)
+    K = 10 if strains else 6
+    J = np.zeros((G, K, nq))
+    cp_ds = np.zeros((G, 4, 2))          # B_xi - B_s on the s_1, s_n columns: eps' ds/dchi
+    chi = np.empty((3, 2))
+    A3 = np.empty((3, 3))
+    x_l = np.empty(8)
+    x_p = np.empty(8)
+    for g in range(G):
+        for j in range(3):                                            # J_r
+            for a in range(na):
+                J[g, j, 3 * a + j] = X[g, 0, a]
+            for c in range(2):
+                J[g, j, i_s1 + c] = RR[g, 4, j] * dl[c] - RR[g, 1, j] * q_ds[g, c]
+        for i in range(2):                                            # d(alpha, beta)/dchi|_s
+            c_l = (dpsi[g, i, 0] * RR[g, 5, 0] + dpsi[g, i, 1] * RR[g, 5, 1]
+                   + dpsi[g, i, 2] * RR[g, 5, 2])
+            c_s = (dpsi[g, i, 0] * RR[g, 2, 0] + dpsi[g, i, 1] * RR[g, 2, 1]
+                   + dpsi[g, i, 2] * RR[g, 2, 2])
+            for c in range(2):
+                chi[i, c] = c_l * dl[c] - c_s * q_ds[g, c]
+        for c in range(2):
+            chi[2, c] = TT[g, 3] * dl[c] - TT[g, 1] * q_ds[g, c]
+        for i in range(3):                                            # J_w (Eqs. 30-31)
+            for j in range(3):
+                A3[i, j] = tmat[g, i, 0] * dpsi[g, 0, j] + tmat[g, i, 1] * dpsi[g, 1, j]
+            for a in range(na):
+                x1 = X[g, 1, a]
+                J[g, 3 + i, 3 * a] = A3[i, 0] * x1
+                J[g, 3 + i, 3 * a + 1] = A3[i, 1] * x1
+                J[g, 3 + i, 3 * a + 2] = A3[i, 2] * x1
+            for a in range(nt):
+                J[g, 3 + i, npos + a] = tmat[g, i, 2] * Y[g, 0, a]
+            for c in range(2):
+                J[g, 3 + i, i_s1 + c] = (tmat[g, i, 0] * chi[0, c] + tmat[g, i, 1] * chi[1, c]
+                                         + tmat[g, i, 2] * chi[2, c])
+        if strains:                                                   # B_s
+            for j in range(3):
+                x_l[j] = RR[g, 5, j]
+                x_l[3 + j] = RR[g, 6, j]
+                x_p[j] = RR[g, 2, j]
+                x_p[3 + j] = RR[g, 3, j]
+            x_l[6] = TT[g, 3]
+            x_l[7] = TT[g, 4]
+            x_p[6] = TT[g, 1]
+            x_p[7] = TT[g, 2]
+            for r in range(4):
+                for a in range(na):
+                    x1 = X[g, 1, a]
+                    x2 = X[g, 2, a]
+                    for j in range(3):
+                        J[g, 6 + r, 3 * a + j] = d[g, r, j] * x1 + d[g, r, 3 + j] * x2
+                for a in range(nt):
+                    J[g, 6 + r, npos + a] = d[g, r, 6] * Y[g, 0, a] + d[g, r, 7] * Y[g, 1, a]
+                cl = 0.0
+                cp = 0.0
+                for k in range(8):
+                    cl += d[g, r, k] * x_l[k]
+                    cp += d[g, r, k] * x_p[k]
+                for c in range(2):
+                    cp_ds[g, r, c] = cp * q_ds[g, c]
+                    J[g, 6 + r, i_s1 + c] = cl * dl[c] - cp_ds[g, r, c]
+
+    # per-row loads v: Fe = v . J (one matrix-vector product) + the dl/dQ energy terms
+    conv = inertia or filt
+    if conv:
+        acc_c, wdot_c, eddot_c = _convective(qe, qde, cstep, n, D_all, q_pos, q_sub, pow_p,
+                                             pow_t, basis, i_s1, filt)
+    v = np.zeros((G, K))
+    Fe_extra = np.zeros(nq)
+    total = 0.0
+    omega = np.empty(3)
+    jw = np.empty(3)
+    for g in range(G):
+        mr = wl[g] * rhoA
+        if inertia:
+            for j in range(3):
+                v[g, j] -= mr * acc_c[g, j]
+            for i in range(3):
+                acc = 0.0
+                for k in range(nq):
+                    acc += J[g, 3 + i, k] * qde[k]
+                omega[i] = acc
+                jw[i] = Jrot[i] * acc
+            v[g, 3] -= wl[g] * (Jrot[0] * wdot_c[g, 0] + omega[1] * jw[2] - omega[2] * jw[1])
+            v[g, 4] -= wl[g] * (Jrot[1] * wdot_c[g, 1] + omega[2] * jw[0] - omega[0] * jw[2])
+            v[g, 5] -= wl[g] * (Jrot[2] * wdot_c[g, 2] + omega[0] * jw[1] - omega[1] * jw[0])
+        if gravity:
+            for j in range(3):
+                v[g, j] += mr * grav[j]
+        if elasticity:
+            W = 0.0
+            for r in range(4):
+                sig = eps[g, r] * D[r]
+                v[g, 6 + r] -= wl[g] * sig
+                W += 0.5 * sig * eps[g, r]
+                for c in range(2):                                    # B_xi = B_s + eps' ds/dchi
+                    Fe_extra[i_s1 + c] -= wl[g] * sig * cp_ds[g, r, c]
+            total += q_w[g] * W                                       # dU/dl at fixed xi
+        if filt:
+            for r in range(4):
+                edot = 0.0
+                for k in range(nq):
+                    edot += J[g, 6 + r, k] * qde[k]
+                v[g, 6 + r] -= wl[g] * D[r] * (0.5 * h * edot + (h * h / 6.0) * eddot_c[g, r])
+    J2 = J.reshape(G * K, nq)
+    Fe = np.dot(v.reshape(G * K), J2)
+    for k in range(nq):
+        Fe[k] += Fe_extra[k]
+    if elasticity:
+        inv = 1.0 / (n - 1)
+        Fe[i_s1] += total * inv       # dl/ds_1 = -1/(n-1), with the minus of F -= ...
+        Fe[i_s1 + 1] -= total * inv
+
+    if not needs_mass or not (inertia or filt):
+        if needs_mass:
+            return np.zeros((nq, nq)), Fe
+        return np.zeros((0, 0)), Fe
+    # mass: Me = A^T A with the weighted rows sqrt(w c) J of all points (one BLAS product); rows
+    # of a zero constant c (e.g. J_t = J_b = 0) are left out
+    sel = np.empty(10, dtype=np.int64)
+    cm = np.empty(10)
+    km = 0
+    if inertia:
+        for i in range(6):
+            c = rhoA if i < 3 else Jrot[i - 3]
+            if c != 0.0:
+                sel[km] = i
+                cm[km] = c
+                km += 1
+    if filt:
+        for r in range(4):
+            if D[r] != 0.0:
+                sel[km] = 6 + r
+                cm[km] = (h * h / 6.0) * D[r]
+                km += 1
+    A = np.empty((G, km, nq))
+    for g in range(G):
+        for i in range(km):
+            wi = np.sqrt(wl[g] * cm[i])
+            for k in range(nq):
+                A[g, i, k] = J[g, sel[i], k] * wi
+    return _gram(A.reshape(G * km, nq)), Fe
+
+
+def _gram_dot(A):
+    """A^T A (numba's np.dot, BLAS gemm)."""
+    return np.dot(A.T, A)
+
+
+def _gram_syrk(A):
+    """A^T A by BLAS dsyrk (half the products of gemm) on the C-ordered (m, nq) A, i.e. the
+    Fortran-ordered A^T: C = A^T (A^T)^T, upper triangle in Fortran order = lower in C order."""
+    m, nq = A.shape
+    C = np.zeros((nq, nq))
+    uplo = np.array([ord("U")], dtype=np.uint8)
+    trans = np.array([ord("N")], dtype=np.uint8)
+    nn = np.array([nq], dtype=np.int32)
+    kk = np.array([m], dtype=np.int32)
+    alpha = np.ones(1)
+    beta = np.zeros(1)
+    if m > 0:
+        _dsyrk(uplo.ctypes, trans.ctypes, nn.ctypes, kk.ctypes, alpha.ctypes, A.ctypes,
+               nn.ctypes, beta.ctypes, C.ctypes, nn.ctypes)
+    for i in range(nq):
+        for j in range(i + 1, nq):
+            C[i, j] = C[j, i]
+    return C
+
+
+_SYRK = False
+if AVAILABLE:
+    # dsyrk of scipy's BLAS (the library numba's np.dot uses) as an external symbol, so that the
+    # compiled functions stay cacheable; np.dot (gemm) where it cannot be found
+    try:
+        import llvmlite.binding as _llb
+        from numba import types as _types
+        from numba.extending import get_cython_function_address as _cython_address
+
+        _llb.add_symbol("sim_core_element_dsyrk",
+                        _cython_address("scipy.linalg.cython_blas", "dsyrk"))
+        _dsyrk = _types.ExternalFunction("sim_core_element_dsyrk",
+                                         _types.void(*([_types.voidptr] * 10)))
+        _SYRK = True
+    except Exception:        # pragma: no cover - scipy without cython_blas
+        _SYRK = False
+
+
+if AVAILABLE:
+    _jit = cardan_compiled.numba.njit(cache=True, nogil=True)
+    _centre_line = _jit(_centre_line)
+    _convective = _jit(_convective)
+    _gram = _jit(_gram_syrk if _SYRK else _gram_dot)
+    _compiled_mass_force = _jit(_mass_force)
+
+
+def element_mass_force(el, qe, qde, rhoA, Jrot, D, h=0.0, g=None, inertia=True,
+                       elasticity=True, needs_mass=True, cstep=_CSTEP):
+    """Element mass matrix (or None) and force vector, M q_ddot = F, of spline element ``el``
+    (a ``SplineElement``) at the real state (qe, qde), for the effects
+
+    * Inertia (``inertia``; mass per length ``rhoA``, rotary inertia ``Jrot`` = (J_s, J_t, J_b)
+      per length, mass centre on the reference line),
+    * Elasticity (``elasticity``; ``D`` = (EA, GJ, EI_t, EI_b)),
+    * StressFilter(h) (``h`` > 0; 0 = off; also uses ``D``),
+    * Gravity(g) (``g`` (3,) global, None or zeros = off),
+
+    i.e. the totals of ``Model.element_mass_force(Model.element_context(t, el, qe, qde))`` with
+    those effects.  ``needs_mass=False`` returns (None, Fe) (the mass products are skipped).
+    Raises RuntimeError if numba is not installed (use the Model path then).
+    """
+    if not AVAILABLE:
+        raise RuntimeError("numba is not installed: use Model.element_mass_force")
+    if el._tables_key[0] is not el.q_xi or el._tables_key[1] is not el.q_sub:
+        el._basis_tables()
+    qe = np.ascontiguousarray(qe, dtype=float)
+    qde = np.ascontiguousarray(qde, dtype=float)
+    grav = np.zeros(3) if g is None else np.ascontiguousarray(g, dtype=float)
+    Me, Fe = _compiled_mass_force(
+        qe, qde, el.n, el._q_phi, el._q_psi, el._pow_p, el._pow_t, el._q_ds_dchi, el.q_w,
+        el._q_pos, el.q_sub, el._D_all, el.G, el.i_s1, float(rhoA),
+        np.ascontiguousarray(Jrot, dtype=float), np.ascontiguousarray(D, dtype=float),
+        float(h), grav, bool(inertia), bool(elasticity), bool(np.any(grav != 0.0)),
+        bool(needs_mass), float(cstep))
+    return (Me if needs_mass else None), Fe
+
+
+def effect_parameters(effects, section):
+    """Keyword arguments of :func:`element_mass_force` for a model's effect list and a beam
+    section (``Inertia``, ``Elasticity``, ``StressFilter``, ``Gravity`` only; a section with a
+    mass-centre offset is not covered).  Raises ValueError otherwise."""
+    from ..effects import Elasticity, Gravity, Inertia, StressFilter
+
+    if section.has_offset:
+        raise ValueError("mass-centre offset (y_c, z_c) is not covered by the compiled element")
+    kw = dict(rhoA=section.rhoA, Jrot=section.J, D=section.D, h=0.0, g=np.zeros(3),
+              inertia=False, elasticity=False)
+    seen = set()
+    for eff in effects:
+        kind = type(eff)
+        if kind not in (Inertia, Elasticity, StressFilter, Gravity) or kind in seen:
+            raise ValueError(f"effect {kind.__name__} (or a second one of its kind) is not "
+                             "covered by the compiled element")
+        seen.add(kind)
+        if kind is Inertia:
+            kw["inertia"] = True
+        elif kind is Elasticity:
+            kw["elasticity"] = True
+        elif kind is StressFilter:
+            kw["h"] = eff.h
+        else:
+            kw["g"] = np.asarray(eff.g, dtype=float)
+    return kw
