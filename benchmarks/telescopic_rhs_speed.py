@@ -19,6 +19,8 @@ last evaluation, and a benchmark that repeats one state measures cache hits.  Va
 * ``+ compiled micro-motion`` and the micro-motion Newton (Eqs. 59-71) compiled too,
 * ``+ compiled points``       and the one-point kinematics of the constraint, rope and contact
   points (``sim_core.beam.point_compiled``),
+* ``+ compiled elements``     and the element mass matrices and forces
+  (``sim_core.beam.element_compiled``),
 
 then a cProfile of the last variant, grouped by what the time is spent on.  Ratios within one
 run are what the table is for; the machine may be shared.
@@ -40,19 +42,21 @@ import numpy as np
 
 sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..")))
 
-from sim_core.beam import cardan_compiled, point_compiled     # noqa: E402
+from sim_core.beam import cardan_compiled, element_compiled, point_compiled  # noqa: E402
 from sim_core.contact import micro_motion_compiled            # noqa: E402
 from sim_core.result import atomic_write_bytes                # noqa: E402
 from jacobian_speed import sliding_state                      # noqa: E402  (benchmarks/)
 
 OUT = os.path.join(os.path.dirname(__file__), "results", "telescopic_rhs_speed.md")
 
-# (label, multiplier Newton, compiled section state, micro-motion Newton, point kinematics)
-VARIANTS = (("fixed point, numpy", False, False, False, False),
-            ("Newton, numpy", True, False, False, False),
-            ("+ compiled section", True, True, False, False),
-            ("+ compiled micro-motion", True, True, True, False),
-            ("+ compiled points", True, True, True, True))
+# (label, multiplier Newton, compiled: section state, micro-motion Newton, point kinematics,
+# element mass and forces)
+VARIANTS = (("fixed point, numpy", False, False, False, False, False),
+            ("Newton, numpy", True, False, False, False, False),
+            ("+ compiled section", True, True, False, False, False),
+            ("+ compiled micro-motion", True, True, True, False, False),
+            ("+ compiled points", True, True, True, True, False),
+            ("+ compiled elements", True, True, True, True, True))
 
 # cProfile groups: (label, function names whose cumulative time is the group's; nested
 # groups are subtracted from their parents below)
@@ -62,15 +66,17 @@ GROUPS = (
     ("saddle-point factorisation", ("kkt_factor",)),
     ("saddle-point solves", ("lu_solve",)),
     ("point effects (payload, ropes)", ("add",)),
-    ("elements (kinematics, mass, forces)", ("element_contexts", "element_mass_force")),
+    ("elements (kinematics, mass, forces)", ("element_terms",)),
 )
 
 
-def _configure(m, newton: bool, section: bool, micro: bool, points: bool) -> None:
+def _configure(m, newton: bool, section: bool, micro: bool, points: bool,
+               elements: bool) -> None:
     m.multiplier_newton = newton
     cardan_compiled.AVAILABLE = section and cardan_compiled.numba is not None
     micro_motion_compiled.AVAILABLE = micro and micro_motion_compiled.numba is not None
     point_compiled.AVAILABLE = points and cardan_compiled.numba is not None
+    element_compiled.AVAILABLE = elements and cardan_compiled.numba is not None
 
 
 def states(y, count: int, seed: int = 1):

@@ -140,6 +140,18 @@ if AVAILABLE:
     _compiled = numba.njit(cache=True, nogil=True)(_kernel)
 
 
+def check_finite(total, what: str) -> None:
+    """numpy's floating-point error handling for the compiled kernels, which compute silently:
+    where numpy is set to raise on invalid operations or overflow (``np.errstate``, as the
+    integrator's right-hand side is: a blown-up stage is rejected, not fatal), a non-finite
+    result (``total``: a sum of the kernel's outputs, non-finite if any is) raises
+    FloatingPointError; elsewhere it propagates as numpy's NaN would."""
+    if not np.isfinite(total):
+        err = np.geterr()
+        if err["invalid"] == "raise" or err["over"] == "raise":
+            raise FloatingPointError(f"non-finite {what} (compiled kernel)")
+
+
 def section_state_arrays(rp, rpp, gam, gamp, basis):
     """(eps, deps_dx, angles, dpsi_drp, tmat, frame, psi_prime) as in ``cardan.section_state``,
     in the common dtype of the inputs (float64 or complex128)."""
@@ -158,4 +170,5 @@ def section_state_arrays(rp, rpp, gam, gamp, basis):
     angles = np.empty((G, 3), dtype=dt)
     psi_prime = np.empty((G, 3), dtype=dt)
     _compiled(rp, rpp, gam, gamp, basis, eps, d, dpsi, tmat, frame, angles, psi_prime)
+    check_finite(d.sum() + frame.sum(), "section state")     # d: strains' derivatives
     return eps, d, angles, dpsi, tmat, frame, psi_prime

@@ -491,6 +491,8 @@ def element_mass_force(el, qe, qde, rhoA, Jrot, D, h=0.0, g=None, inertia=True,
         np.ascontiguousarray(Jrot, dtype=float), np.ascontiguousarray(D, dtype=float),
         float(h), grav, bool(inertia), bool(elasticity), bool(np.any(grav != 0.0)),
         bool(needs_mass), float(cstep))
+    cardan_compiled.check_finite(Fe.sum() + (Me.sum() if needs_mass else 0.0),
+                                 "element mass matrix or forces")
     return (Me if needs_mass else None), Fe
 
 

@@ -119,4 +119,6 @@ def point_kinematics(el, qe, s):
     material coordinate s (real or complex-step; qe real or complex)."""
     dt = np.result_type(qe, s, float)
     qe = np.ascontiguousarray(qe, dtype=dt)
-    return _compiled_point(qe, dt.type(s), el.n, el._D_all, el._pow_p, el._pow_t, el.G, el.i_s1)
+    out = _compiled_point(qe, dt.type(s), el.n, el._D_all, el._pow_p, el._pow_t, el.G, el.i_s1)
+    cardan_compiled.check_finite(sum(a.sum() for a in out[:5]), "point kinematics")
+    return out

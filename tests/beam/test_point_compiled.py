@@ -45,3 +45,27 @@ def test_point_kinematics_equals_evaluate(complex_step, where):
             np.testing.assert_allclose(part(a), part(b), rtol=0, atol=tol, err_msg=name)
         if complex_step and name in ("r", "J_r", "angles"):
             assert np.abs(np.imag(b)).max() > 0, name       # the perturbation is carried
+
+
+@pytest.mark.skipif(not point_compiled.AVAILABLE, reason="numba not installed")
+def test_compiled_kernels_follow_numpy_error_handling():
+    """The compiled kernels compute silently; like numpy they raise FloatingPointError on a
+    non-finite result where np.errstate says raise (the integrator's right-hand side: a blown-up
+    stage is then rejected and retried, tests/scenes/test_partial_result.py), and otherwise let
+    NaN propagate."""
+    from sim_core.beam.element_compiled import element_mass_force
+
+    el, qe, qde = _bent_element(5)
+    bad = qe.copy()
+    bad[0] = np.inf
+    s = 0.5 * (qe[el.i_s1] + qe[el.i_sn])
+    args = dict(rhoA=80.0, Jrot=np.array([0.3, 0.1, 0.1]), D=np.array([2e9, 1e7, 3e7, 4e7]),
+                h=0.01, g=np.array([0.0, 0.0, -9.81]))
+    with np.errstate(invalid="raise", over="raise"):
+        with pytest.raises(FloatingPointError, match="point kinematics"):
+            point_compiled.point_kinematics(el, bad, s)
+        with pytest.raises(FloatingPointError, match="element mass matrix"):
+            element_mass_force(el, bad, qde, **args)
+    with np.errstate(invalid="ignore", over="ignore"):
+        assert not np.all(np.isfinite(point_compiled.point_kinematics(el, bad, s)[2]))
+        assert not np.all(np.isfinite(element_mass_force(el, bad, qde, **args)[1]))
