@@ -146,12 +146,12 @@ def material_point(model, ibeam: int, s_fixed: float | None = None, s_index: int
 
     def f(Q):
         cols = coords(Q)
-        vals = Q[cols]
-        for c, v, res in memo:
-            if v.dtype == vals.dtype and np.array_equal(c, cols) and np.array_equal(v, vals):
+        key = cols.tobytes() + Q[cols].tobytes()      # exact: the same coordinates and values
+        for k, dt, res in memo:
+            if dt == Q.dtype and k == key:
                 return res
         res = _evaluate(Q)
-        memo[:] = [m for m in memo if m[1].dtype != vals.dtype][:1] + [(cols, vals, res)]
+        memo[:] = [m for m in memo if m[1] != Q.dtype][:1] + [(key, Q.dtype, res)]
         return res
 
     def _evaluate(Q):

@@ -186,8 +186,12 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
     # telescopic cylinder between the left sections of booms 1 and 2 (A3, A4)
     sched = CubicSmoothstepSchedule(v_max=p.v_max, t_ramp=p.t_ramp, t_hold_end=p.t_hold_end,
                                     sign=p.direction, s0=Ls)
+    def cylinder_length(t):                        # one sample of the schedule: (L, L', L'')
+        smp = sched.sample(t)
+        return smp.s, smp.v, smp.a
+
     add(distance_driver("telescopic_cylinder", mp(1, s_fixed=0.0), mp(0, s_fixed=0.0),
-                        lambda t: (sched.stroke(t), sched.rate(t), sched.accel(t))))
+                        cylinder_length))
     model.nonlinear = cons
     rows, i = {}, 0
     for nm, m in names:

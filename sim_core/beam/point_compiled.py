@@ -106,8 +106,14 @@ def _point(qe, s, n, D_all, pow_p, pow_t, basis, i_s1):
         J_psi[2, npos + a] = Y[0, a]
     J_psi[2, i_s1] = TT[3] * dl0 - TT[1] * ds0
     J_psi[2, i_s1 + 1] = TT[3] * dl1 - TT[1] * ds1
+    total = 0.0                      # finiteness check of the outputs (check_finite)
+    for i in range(3):
+        total += (RR[0, i].real + RR[0, i].imag + angles[0, i].real + angles[0, i].imag
+                  + frame[0, 2, i].real)
+        for k in range(nq):
+            total += J_r[i, k].real + J_r[i, k].imag + J_psi[i, k].real + J_psi[i, k].imag
     return (RR[0].copy(), RR[1].copy(), J_r, J_psi, angles[0].copy(), psi_prime[0].copy(),
-            frame[0].copy(), tmat[0].copy())
+            frame[0].copy(), tmat[0].copy(), total)
 
 
 if AVAILABLE:
@@ -119,6 +125,7 @@ def point_kinematics(el, qe, s):
     material coordinate s (real or complex-step; qe real or complex)."""
     dt = np.result_type(qe, s, float)
     qe = np.ascontiguousarray(qe, dtype=dt)
-    out = _compiled_point(qe, dt.type(s), el.n, el._D_all, el._pow_p, el._pow_t, el.G, el.i_s1)
-    cardan_compiled.check_finite(sum(a.sum() for a in out[:5]), "point kinematics")
-    return out
+    *out, total = _compiled_point(qe, dt.type(s), el.n, el._D_all, el._pow_p, el._pow_t, el.G,
+                                  el.i_s1)
+    cardan_compiled.check_finite(total, "point kinematics")
+    return tuple(out)

@@ -9,7 +9,8 @@ times per right-hand side, and each Python iteration was ~20 small numpy calls. 
 loop stays as the reference and the fallback without numba;
 ``tests/contact/test_sliding_block_contact.py`` checks that both give the same solution.
 
-Status codes: 0 converged, 1 singular Newton matrix, 2 line search failed, 3 no convergence in
+Returns (x, status, iterations, max |S R|, delta, f, f', R, z) with z = J^-T A^T f' the load
+sensitivity at the solution (zeros unless converged).  Status codes: 0 converged, 1 singular Newton matrix, 2 line search failed, 3 no convergence in
 max_iter iterations (the caller raises ContactSolveError with the reason).
 """
 
@@ -31,7 +32,7 @@ def _spring(delta, k0, inv_eps, f, fp):
     """Eqs. 62-63 with the cubic transition (SpringLaw.force_and_tangent), in place."""
     for i in range(delta.shape[0]):
         x = min(max(delta[i] * inv_eps, 0.0), 1.0)
-        kx2 = k0 * x * x
+        kx2 = k0 * (x * x)              # the order of SpringLaw.force_and_tangent
         f[i] = kx2 * (3.0 - 2.0 * x) * delta[i]
         fp[i] = kx2 * (9.0 - 8.0 * x)
 
@@ -48,6 +49,26 @@ def _residual(GT, c5, S, f, R, SR):
         phi += SR[r] * SR[r]
         err = max(err, abs(SR[r]))
     return phi, err
+
+
+def _sensitivity(A, GT, kappa_GA, fp):
+    """z = (J + kappa)^-T A^T f' at the solution: d(sum f)/dc = -z
+    (ContactSolution.normal_load_gradient); zero where no spring is on its stiff branch."""
+    n = A.shape[0]
+    rhs = np.zeros(5)
+    for c in range(5):
+        for i in range(n):
+            rhs[c] += A[i, c] * fp[i]
+    if not np.any(rhs != 0.0):
+        return rhs
+    JT = np.empty((5, 5))
+    for r in range(5):
+        for c in range(5):
+            acc = kappa_GA[r, c]
+            for i in range(n):
+                acc += GT[r, i] * fp[i] * A[i, c]
+            JT[c, r] = acc
+    return np.linalg.solve(JT, rhs)
 
 
 def _newton(A, GT, kappa_GA, c5, S, x, k0, eps, tol, load_scale, max_iter):
@@ -73,12 +94,12 @@ def _newton(A, GT, kappa_GA, c5, S, x, k0, eps, tol, load_scale, max_iter):
     it = 0
     while True:
         if err <= tol:
-            return x, 0, it, err
+            return x, 0, it, err, delta, f, fp, R, _sensitivity(A, GT, kappa_GA, fp)
         floor = 64.0 * _EPS * (row_scale * f.sum() + load_scale)
         if err <= floor:
-            return x, 0, it, err
+            return x, 0, it, err, delta, f, fp, R, _sensitivity(A, GT, kappa_GA, fp)
         if it == max_iter:
-            return x, 3, it, err
+            return x, 3, it, err, delta, f, fp, R, np.zeros(5)
         # Newton matrix J = G^T diag(f') A + kappa (A^T A + mu Bf^T A)
         for r in range(5):
             for c in range(5):
@@ -89,9 +110,9 @@ def _newton(A, GT, kappa_GA, c5, S, x, k0, eps, tol, load_scale, max_iter):
         try:
             d = np.linalg.solve(Jm, -R)
         except Exception:  # noqa: BLE001 - numba raises a generic LinAlgError here
-            return x, 1, it, err
+            return x, 1, it, err, delta, f, fp, R, np.zeros(5)
         if not np.isfinite(d @ d):
-            return x, 1, it, err
+            return x, 1, it, err, delta, f, fp, R, np.zeros(5)
         dd = A @ d
         step_max = np.abs(dd).max()
         cap = 4.0 * max(delta.max(), eps)
@@ -109,8 +130,8 @@ def _newton(A, GT, kappa_GA, c5, S, x, k0, eps, tol, load_scale, max_iter):
             s *= 0.5
         if not accepted:
             if err <= 1e3 * floor:
-                return x, 0, it, err
-            return x, 2, it, err
+                return x, 0, it, err, delta, f, fp, R, _sensitivity(A, GT, kappa_GA, fp)
+            return x, 2, it, err, delta, f, fp, R, np.zeros(5)
         x = x_n.copy()
         delta = delta_n
         f[:] = f_n
@@ -124,4 +145,5 @@ def _newton(A, GT, kappa_GA, c5, S, x, k0, eps, tol, load_scale, max_iter):
 if AVAILABLE:            # the callees first: numba resolves the globals when newton compiles
     _spring = numba.njit(cache=True, nogil=True)(_spring)
     _residual = numba.njit(cache=True, nogil=True)(_residual)
+    _sensitivity = numba.njit(cache=True, nogil=True)(_sensitivity)
     newton = numba.njit(cache=True, nogil=True)(_newton)

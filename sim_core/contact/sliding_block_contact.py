@@ -383,6 +383,7 @@ class ContactSolution:
     iterations: int
     tangent: np.ndarray = field(repr=False)
     newton_floor: np.ndarray | None = field(default=None, repr=False)   # kappa (A^T A + mu Bf^T A)
+    load_sensitivity: np.ndarray | None = field(default=None, repr=False)  # z, if already formed
 
     @property
     def jacobian(self) -> np.ndarray:
@@ -430,6 +431,8 @@ class ContactSolution:
         """z = J^-T A^T f': d sum f / dc = -z.  Solved with the Newton matrix's stiffness floor
         kappa (it changes z by a relative ~1e-10 and keeps directions that compress no active
         spring regular); by least squares where the solution carries no floor."""
+        if self.load_sensitivity is not None:
+            return self.load_sensitivity
         g = self.geometry
         rhs = g.AT @ self.tangent
         if not rhs.any():
@@ -540,12 +543,12 @@ def solve_micro_motion(geom: SliderGeometry, spring: SpringLaw, f_c, m_c, mu_val
     load_scale = max(abs(ft), abs(fb), Lr * abs(ms), Lr * abs(mt), Lr * abs(mb))
     fat = spring.force_and_tangent
 
-    def finish(x, delta, f, fp, R, it, floor=None):
+    def finish(x, delta, f, fp, R, it, floor=None, sensitivity=None):
         fr = mu * f
         gf = GT @ f                     # (fbar_t, fbar_b, mbar_s, mbar_t, mbar_b), Eq. 66
         f_bar = np.array([-float(fr.sum()), gf[0], gf[1]])
         return ContactSolution(geom, mu, x, delta, f, fr, f_bar, gf[2:5].copy(), R,
-                               fs + float(f_bar[0]), it, fp, floor)  # aux: Eq. 72
+                               fs + float(f_bar[0]), it, fp, floor, sensitivity)  # aux: Eq. 72
 
     if load_scale == 0.0:
         # zero load: every x with all delta <= 0 solves Eqs. 67-71; return the rest position
@@ -566,13 +569,10 @@ def solve_micro_motion(geom: SliderGeometry, spring: SpringLaw, f_c, m_c, mu_val
     tol = rtol * load_scale
     if _compiled.AVAILABLE and type(spring) is SpringLaw:
         # the same Newton as the loop below, compiled (micro_motion_compiled)
-        x, status, it, err = _compiled.newton(A, GT, kappa_GA, c5, S, x, spring.k0, spring.eps,
-                                              tol, load_scale, max_iter)
-        delta = A @ x
-        f, fp = fat(delta)
-        R = c5 + GT @ f
+        x, status, it, err, delta, f, fp, R, z = _compiled.newton(
+            A, GT, kappa_GA, c5, S, x, spring.k0, spring.eps, tol, load_scale, max_iter)
         if status == 0:
-            return finish(x, delta, f, fp, R, it, kappa_GA)
+            return finish(x, delta, f, fp, R, it, kappa_GA, z)
         reason = {1: "singular Newton matrix",
                   2: f"line search failed (|S R| = {err:.3e}, tol {tol:.3e})",
                   3: f"no convergence in {max_iter} Newton iterations "
