@@ -18,7 +18,7 @@ import scipy.linalg as sla
 from .beam import element_compiled
 from .beam.moving_node_beam import Beam
 from .constraints import constraint_terms, kkt_accelerations, kkt_factor
-from .effects import Effect, ElementContext, PointLoad
+from .effects import Effect, ElementContext, Gravity, PointLoad, StressFilter
 
 _CSTEP = 1e-20   # complex-step size (no subtractive cancellation, any tiny value works)
 
@@ -159,18 +159,28 @@ class Model:
         return self.element_mass_force(self.element_context(t, el, qe, qde, kin), mass)
 
     def _compiled_effects(self, section):
-        """element_compiled's effect arguments for this section (read from the effects at
-        every call: statics scale the gravity of an effect in place), or None where the kernel
-        does not cover the effects (that verdict is kept per section and effect list)."""
+        """element_compiled's effect arguments for this section, or None where the kernel does
+        not cover the effects.  The verdict and the constant arguments are kept per section and
+        effect list; the gravity vector and the filter's h are read at every call (statics scale
+        the gravity of an effect in place)."""
         key = (id(section), tuple(id(e) for e in self.effects))
-        covered = self.__dict__.setdefault("_compiled_covered", {})
-        if covered.get(key) is False:
+        cache = self.__dict__.setdefault("_compiled_kw", {})
+        if key not in cache:
+            try:
+                kw = element_compiled.effect_parameters(self.effects, section)
+                grav = [e for e in self.effects if isinstance(e, Gravity)]
+                filt = [e for e in self.effects if isinstance(e, StressFilter)]
+                cache[key] = (kw, grav[0] if grav else None, filt[0] if filt else None)
+            except ValueError:
+                cache[key] = None
+        entry = cache[key]
+        if entry is None:
             return None
-        try:
-            kw = element_compiled.effect_parameters(self.effects, section)
-        except ValueError:
-            kw = None
-        covered[key] = kw is not None
+        kw, grav, filt = entry
+        if grav is not None:
+            kw["g"] = np.asarray(grav.g, dtype=float)
+        if filt is not None:
+            kw["h"] = filt.h
         return kw
 
     def mass_force(self, t: float, Q: np.ndarray, Qd: np.ndarray, mass: bool = True):
