@@ -10,7 +10,8 @@ Writes benchmarks/results/cost_growth.csv and cost_growth.png.
 Per configuration (case 9.1 stiffness, E = 2.1e12 Pa, 1 t payload, no friction, filter
 h = 0.01 s; ``TelescopicParams(n_booms=N, n_nodes=n_sub + 1)``):
 
-* ``rhs_ms``: one ``model.rhs`` (KKT solve), best of 5 repeats of 3 calls (process time);
+* ``rhs_ms``: one ``model.rhs`` (KKT solve), best of 5 repeats of 3 calls (process time), each
+  call at a slightly different state (no cache hits);
 * an RK45 run (rtol 1e-5, atol 1e-6) over a window of T = 0.1 s **from the straight initial
   configuration** (the static equilibrium costs 10-60 s per model and is skipped here): steps,
   RHS evaluations, and ``wall_per_sim_s`` = process time / T.  With the filter on, RK45 is
@@ -52,11 +53,16 @@ def measure(n_booms: int, n_sub: int, sweep: str) -> dict:
     m = ts.model
     z0, zd0 = m.reduced_state(0.0, ts.Q0, np.zeros_like(ts.Q0))
     y0 = np.concatenate([z0, zd0])
+    # every call at a state of its own (relative perturbation 1e-9): the point functions keep
+    # their last evaluation, so repeating one state would time cache hits (2026-11-24)
+    rng = np.random.default_rng(0)
+    ys = [y0 + 1e-9 * (np.abs(y0) + 1e-3) * rng.standard_normal(len(y0)) for _ in range(16)]
+    m.rhs(0.0, ys[-1])
     best = np.inf
-    for _ in range(5):
+    for r in range(5):
         t0 = time.process_time()
-        for _ in range(3):
-            m.rhs(0.0, y0)
+        for k in range(3):
+            m.rhs(0.0, ys[3 * r + k])
         best = min(best, (time.process_time() - t0) / 3)
     row = {"sweep": sweep, "n_booms": n_booms, "n_sub": n_sub, "n_dof": m.n_dof,
            "rhs_ms": 1e3 * best, "t_sim": T}
