@@ -122,7 +122,9 @@ def main():
              "terms make it ~ h / |v| relative, and at this state the just-taut retraction rope "
              "sits on its tension-only ramp (C1, 1e-6 m wide), whose curvature both sides "
              "see differently.  tests/integrators/test_state_jacobian.py checks the two "
-             "Jacobians with central differences off the ramp (2e-7).\n")
+             "Jacobians with central differences off the ramp (2e-7).  `rhs (ms)` repeats one "
+             "state, so the point functions' one-entry caches hit: a run's right-hand sides cost "
+             "more (`telescopic_rhs_speed.md`), and the ratios to it are upper bounds.\n")
     atomic_write_bytes(os.path.join(OUT, "jacobian_speed.csv"), csv.getvalue().encode())
     atomic_write_bytes(os.path.join(OUT, "jacobian_speed.md"), md.getvalue().encode())
 
