@@ -146,7 +146,7 @@ def material_point(model, ibeam: int, s_fixed: float | None = None, s_index: int
 
     def f(Q):
         cols = coords(Q)
-        key = cols.tobytes() + Q[cols].tobytes()      # exact: the same coordinates and values
+        key = (cols.tobytes(), Q[cols].tobytes())     # exact: the same coordinates and values
         for k, dt, res in memo:
             if dt == Q.dtype and k == key:
                 return res
