@@ -136,8 +136,42 @@ def _kernel(rp, rpp, gam, gamp, basis, eps, d, dpsi, tmat, frame, angles, psi_pr
         psi_prime[g, 2] = gamp[g]
 
 
+def _allocate_and_run(rp, rpp, gam, gamp, basis):
+    """(eps, d, angles, dpsi, tmat, frame, psi_prime) in the dtype of rp (callable from other
+    compiled functions)."""
+    G = rp.shape[0]
+    dt = rp.dtype
+    eps = np.empty((G, 4), dtype=dt)
+    d = np.empty((G, 4, 8), dtype=dt)
+    dpsi = np.empty((G, 2, 3), dtype=dt)
+    tmat = np.empty((G, 3, 3), dtype=dt)
+    frame = np.empty((G, 3, 3), dtype=dt)
+    angles = np.empty((G, 3), dtype=dt)
+    psi_prime = np.empty((G, 3), dtype=dt)
+    _compiled(rp, rpp, gam, gamp, basis, eps, d, dpsi, tmat, frame, angles, psi_prime)
+    return eps, d, angles, dpsi, tmat, frame, psi_prime
+
+
+def _length_powers(ell):
+    """l**(-4 .. 2) in the dtype of l: the powers of the sub-element length in the spline basis
+    rows (moving_node_beam, SplineElement.evaluate)."""
+    il = 1.0 / ell
+    il2 = il * il
+    out = np.zeros(7) + 0.0 * ell                 # the dtype of l (float or complex)
+    out[0] = il2 * il2
+    out[1] = il2 * il
+    out[2] = il2
+    out[3] = il
+    out[4] = 1.0
+    out[5] = ell
+    out[6] = ell * ell
+    return out
+
+
 if AVAILABLE:
     _compiled = numba.njit(cache=True, nogil=True)(_kernel)
+    section_state_compiled = numba.njit(cache=True, nogil=True)(_allocate_and_run)
+    length_powers = numba.njit(cache=True, nogil=True)(_length_powers)
 
 
 def check_finite(total, what: str) -> None:
@@ -156,19 +190,12 @@ def section_state_arrays(rp, rpp, gam, gamp, basis):
     """(eps, deps_dx, angles, dpsi_drp, tmat, frame, psi_prime) as in ``cardan.section_state``,
     in the common dtype of the inputs (float64 or complex128)."""
     dt = np.result_type(rp, rpp, gam, gamp, float)
-    G = rp.shape[0]
     rp = np.ascontiguousarray(rp, dtype=dt)
     rpp = np.ascontiguousarray(rpp, dtype=dt)
     gam = np.ascontiguousarray(gam, dtype=dt)
     gamp = np.ascontiguousarray(gamp, dtype=dt)
     basis = np.ascontiguousarray(basis, dtype=float)
-    eps = np.empty((G, 4), dtype=dt)
-    d = np.empty((G, 4, 8), dtype=dt)
-    dpsi = np.empty((G, 2, 3), dtype=dt)
-    tmat = np.empty((G, 3, 3), dtype=dt)
-    frame = np.empty((G, 3, 3), dtype=dt)
-    angles = np.empty((G, 3), dtype=dt)
-    psi_prime = np.empty((G, 3), dtype=dt)
-    _compiled(rp, rpp, gam, gamp, basis, eps, d, dpsi, tmat, frame, angles, psi_prime)
+    eps, d, angles, dpsi, tmat, frame, psi_prime = section_state_compiled(rp, rpp, gam, gamp,
+                                                                         basis)
     check_finite(d.sum() + frame.sum(), "section state")     # d: strains' derivatives
     return eps, d, angles, dpsi, tmat, frame, psi_prime

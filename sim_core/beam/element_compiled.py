@@ -81,16 +81,23 @@ def _centre_line(qe, X, Y, n, basis):
             rpp[g, j] = RR[g, 2, j]
         gam[g] = TT[g, 0]
         gamp[g] = TT[g, 1]
-    eps = np.empty((G, 4), dtype=dt)
-    d = np.empty((G, 4, 8), dtype=dt)
-    dpsi = np.empty((G, 2, 3), dtype=dt)
-    tmat = np.empty((G, 3, 3), dtype=dt)
-    frame = np.empty((G, 3, 3), dtype=dt)
-    angles = np.empty((G, 3), dtype=dt)
-    psi_prime = np.empty((G, 3), dtype=dt)
-    cardan_compiled._compiled(rp, rpp, gam, gamp, basis, eps, d, dpsi, tmat, frame, angles,
-                              psi_prime)
+    eps, d, _, dpsi, tmat, _, _ = cardan_compiled.section_state_compiled(rp, rpp, gam, gamp,
+                                                                         basis)
     return RR, TT, eps, d, dpsi, tmat
+
+
+def _strain_arguments(RR, TT, g, x_l, x_p):
+    """The l-derivatives x_l and s-derivatives x_p of (r', r'', gamma, gamma') at point g (the
+    arguments of the strain derivatives d = d eps / d x, moving_node_beam._kin_B)."""
+    for j in range(3):
+        x_l[j] = RR[g, 5, j]
+        x_l[3 + j] = RR[g, 6, j]
+        x_p[j] = RR[g, 2, j]
+        x_p[3 + j] = RR[g, 3, j]
+    x_l[6] = TT[g, 3]
+    x_l[7] = TT[g, 4]
+    x_p[6] = TT[g, 1]
+    x_p[7] = TT[g, 2]
 
 
 def _convective(qe, qde, cstep, n, D_all, q_pos, q_sub, pow_p, pow_t, basis, i_s1,
@@ -110,16 +117,7 @@ def _convective(qe, qde, cstep, n, D_all, q_pos, q_sub, pow_p, pow_t, basis, i_s
     ellr = (qe[i_s1 + 1] - s1r) / (n - 1)
     s1 = qc[i_s1]
     ell = (qc[i_s1 + 1] - s1) / (n - 1)                               # Eq. 5
-    il = 1.0 / ell
-    il2 = il * il
-    lpow = np.empty(7, dtype=np.complex128)
-    lpow[0] = il2 * il2
-    lpow[1] = il2 * il
-    lpow[2] = il2
-    lpow[3] = il
-    lpow[4] = 1.0
-    lpow[5] = ell
-    lpow[6] = ell * ell
+    lpow = cardan_compiled.length_powers(ell)
     nrow = D_all.shape[2]
     X = np.empty((G, 7, na), dtype=np.complex128)
     Y = np.empty((G, 5, nt), dtype=np.complex128)
@@ -205,15 +203,7 @@ def _convective(qe, qde, cstep, n, D_all, q_pos, q_sub, pow_p, pow_t, basis, i_s
             acc = tmat[g, i, 0] * pdot[0] + tmat[g, i, 1] * pdot[1] + tmat[g, i, 2] * pdot[2]
             w_out[g, i] = acc.imag / cstep
         if with_strain:                                               # B_s q_dot
-            for j in range(3):
-                x_l[j] = RR[g, 5, j]
-                x_l[3 + j] = RR[g, 6, j]
-                x_p[j] = RR[g, 2, j]
-                x_p[3 + j] = RR[g, 3, j]
-            x_l[6] = TT[g, 3]
-            x_l[7] = TT[g, 4]
-            x_p[6] = TT[g, 1]
-            x_p[7] = TT[g, 2]
+            _strain_arguments(RR, TT, g, x_l, x_p)
             for r in range(4):
                 cl = 0.0j
                 cp = 0.0j
@@ -240,16 +230,7 @@ def _mass_force(qe, qde, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_sub,
     strains = elasticity or filt
     s1 = qe[i_s1]
     ell = (qe[i_s1 + 1] - s1) / (n - 1)                               # Eq. 5
-    il = 1.0 / ell
-    il2 = il * il
-    lpow = np.empty(7)
-    lpow[0] = il2 * il2
-    lpow[1] = il2 * il
-    lpow[2] = il2
-    lpow[3] = il
-    lpow[4] = 1.0
-    lpow[5] = ell
-    lpow[6] = ell * ell
+    lpow = cardan_compiled.length_powers(ell)
     X = np.empty((G, 7, na))
     Y = np.empty((G, 5, nt))
     for g in range(G):
@@ -304,15 +285,7 @@ def _mass_force(qe, qde, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_sub,
                 J[g, 3 + i, i_s1 + c] = (tmat[g, i, 0] * chi[0, c] + tmat[g, i, 1] * chi[1, c]
                                          + tmat[g, i, 2] * chi[2, c])
         if strains:                                                   # B_s
-            for j in range(3):
-                x_l[j] = RR[g, 5, j]
-                x_l[3 + j] = RR[g, 6, j]
-                x_p[j] = RR[g, 2, j]
-                x_p[3 + j] = RR[g, 3, j]
-            x_l[6] = TT[g, 3]
-            x_l[7] = TT[g, 4]
-            x_p[6] = TT[g, 1]
-            x_p[7] = TT[g, 2]
+            _strain_arguments(RR, TT, g, x_l, x_p)
             for r in range(4):
                 for a in range(na):
                     x1 = X[g, 1, a]
@@ -457,6 +430,7 @@ if AVAILABLE:
 
 if AVAILABLE:
     _jit = cardan_compiled.numba.njit(cache=True, nogil=True)
+    _strain_arguments = _jit(_strain_arguments)
     _centre_line = _jit(_centre_line)
     _convective = _jit(_convective)
     _gram = _jit(_gram_syrk if _SYRK else _gram_dot)

@@ -40,16 +40,7 @@ def _point(qe, s, n, D_all, pow_p, pow_t, basis, i_s1):
         for k in range(nrow):
             rows[k] += p_xi * D_all[sub, p, k]
         p_xi = p_xi * xi
-    il = 1.0 / ell
-    il2 = il * il
-    lpow = np.empty(7, dtype=dt)
-    lpow[0] = il2 * il2
-    lpow[1] = il2 * il
-    lpow[2] = il2
-    lpow[3] = il
-    lpow[4] = 1.0
-    lpow[5] = ell
-    lpow[6] = ell * ell
+    lpow = cardan_compiled.length_powers(ell)
     X = np.empty((7, na), dtype=dt)
     for i in range(7):
         for a in range(na):
@@ -72,19 +63,8 @@ def _point(qe, s, n, D_all, pow_p, pow_t, basis, i_s1):
     ds0, ds1 = 1.0 - frac, frac                                      # ds/d(s_1, s_n) at xi
     dl0, dl1 = -1.0 / (n - 1), 1.0 / (n - 1)                         # dl/d(s_1, s_n)
 
-    rp = RR[1:2].copy()
-    rpp = RR[2:3].copy()
-    gam = TT[0:1].copy()
-    gamp = TT[1:2].copy()
-    eps = np.empty((1, 4), dtype=dt)
-    d = np.empty((1, 4, 8), dtype=dt)
-    dpsi = np.empty((1, 2, 3), dtype=dt)
-    tmat = np.empty((1, 3, 3), dtype=dt)
-    frame = np.empty((1, 3, 3), dtype=dt)
-    angles = np.empty((1, 3), dtype=dt)
-    psi_prime = np.empty((1, 3), dtype=dt)
-    cardan_compiled._compiled(rp, rpp, gam, gamp, basis, eps, d, dpsi, tmat, frame, angles,
-                              psi_prime)
+    eps, d, angles, dpsi, tmat, frame, psi_prime = cardan_compiled.section_state_compiled(
+        RR[1:2].copy(), RR[2:3].copy(), TT[0:1].copy(), TT[1:2].copy(), basis)
 
     J_r = np.zeros((3, nq), dtype=dt)
     for j in range(3):

@@ -51,6 +51,17 @@ def _residual(GT, c5, S, f, R, SR):
     return phi, err
 
 
+def _newton_matrix(A, GT, kappa_GA, fp, Jm):
+    """J = G^T diag(f') A + kappa (A^T A + mu Bf^T A), in place (the solver's Newton matrix)."""
+    n = A.shape[0]
+    for r in range(5):
+        for c in range(5):
+            acc = kappa_GA[r, c]
+            for i in range(n):
+                acc += GT[r, i] * fp[i] * A[i, c]
+            Jm[r, c] = acc
+
+
 def _sensitivity(A, GT, kappa_GA, fp):
     """z = (J + kappa)^-T A^T f' at the solution: d(sum f)/dc = -z
     (ContactSolution.normal_load_gradient); zero where no spring is on its stiff branch."""
@@ -61,14 +72,9 @@ def _sensitivity(A, GT, kappa_GA, fp):
             rhs[c] += A[i, c] * fp[i]
     if not np.any(rhs != 0.0):
         return rhs
-    JT = np.empty((5, 5))
-    for r in range(5):
-        for c in range(5):
-            acc = kappa_GA[r, c]
-            for i in range(n):
-                acc += GT[r, i] * fp[i] * A[i, c]
-            JT[c, r] = acc
-    return np.linalg.solve(JT, rhs)
+    Jm = np.empty((5, 5))
+    _newton_matrix(A, GT, kappa_GA, fp, Jm)
+    return np.linalg.solve(Jm.T.copy(), rhs)
 
 
 def _newton(A, GT, kappa_GA, c5, S, x, k0, eps, tol, load_scale, max_iter):
@@ -100,13 +106,7 @@ def _newton(A, GT, kappa_GA, c5, S, x, k0, eps, tol, load_scale, max_iter):
             return x, 0, it, err, delta, f, fp, R, _sensitivity(A, GT, kappa_GA, fp)
         if it == max_iter:
             return x, 3, it, err, delta, f, fp, R, np.zeros(5)
-        # Newton matrix J = G^T diag(f') A + kappa (A^T A + mu Bf^T A)
-        for r in range(5):
-            for c in range(5):
-                acc = kappa_GA[r, c]
-                for i in range(n):
-                    acc += GT[r, i] * fp[i] * A[i, c]
-                Jm[r, c] = acc
+        _newton_matrix(A, GT, kappa_GA, fp, Jm)
         try:
             d = np.linalg.solve(Jm, -R)
         except Exception:  # noqa: BLE001 - numba raises a generic LinAlgError here
@@ -145,5 +145,6 @@ def _newton(A, GT, kappa_GA, c5, S, x, k0, eps, tol, load_scale, max_iter):
 if AVAILABLE:            # the callees first: numba resolves the globals when newton compiles
     _spring = numba.njit(cache=True, nogil=True)(_spring)
     _residual = numba.njit(cache=True, nogil=True)(_residual)
+    _newton_matrix = numba.njit(cache=True, nogil=True)(_newton_matrix)
     _sensitivity = numba.njit(cache=True, nogil=True)(_sensitivity)
     newton = numba.njit(cache=True, nogil=True)(_newton)

@@ -338,6 +338,16 @@ def test_jacobian_matches_finite_differences(kind, mu):
         np.testing.assert_allclose(J[:, j], Jfd[:, j], rtol=0, atol=1e-4 * col)
 
 
+def central_gradient(fun, x):
+    """Central differences of a scalar function of the load, relative steps 1e-4 (+1e3 N)."""
+    fd = np.empty(len(x))
+    for j in range(len(x)):
+        e = np.zeros(len(x))
+        e[j] = 1e-4 * (abs(x[j]) + 1e3)
+        fd[j] = (fun(x + e) - fun(x - e)) / (2 * e[j])
+    return fd
+
+
 def test_aux_gradient_matches_finite_differences():
     """d(Eq. 72)/d(f_c, m_c, mu) by the implicit-function theorem vs central differences of
     re-solved problems.  Relative steps 1e-4; solver error 1e-12 of the load / 1e-4 step ~ 1e-8;
@@ -353,12 +363,7 @@ def test_aux_gradient_matches_finite_differences():
         s = solve_micro_motion(g, SPRING, load_vec[:3], load_vec[3:], mu_v, x0=sol.x, rtol=1e-13)
         return s.axial_residual
 
-    fd = np.empty(6)
-    for j in range(6):
-        h = 1e-4 * (abs(load[j]) + 1e3)
-        e = np.zeros(6)
-        e[j] = h
-        fd[j] = (aux(load + e, mu) - aux(load - e, mu)) / (2 * h)
+    fd = central_gradient(lambda x: aux(x, mu), load)
     np.testing.assert_allclose(grad, fd, rtol=0, atol=1e-5 * np.abs(grad).max())
     hm = 1e-5
     fd_mu = (aux(load, mu + hm) - aux(load, mu - hm)) / (2 * hm)
@@ -381,12 +386,7 @@ def test_normal_load_gradient_matches_finite_differences(mu):
                                x0=sol.x, rtol=1e-13)
         return s.total_normal_force
 
-    fd = np.empty(5)
-    for j in range(5):
-        h = 1e-4 * (abs(c5[j]) + 1e3)
-        e = np.zeros(5)
-        e[j] = h
-        fd[j] = (load(c5 + e) - load(c5 - e)) / (2 * h)
+    fd = central_gradient(load, c5)
     assert np.abs(grad).max() > 0.5           # the vertical load alone moves N by ~1 per N
     np.testing.assert_allclose(grad, fd, rtol=0, atol=1e-5 * np.abs(grad).max())
 
