@@ -87,12 +87,14 @@ class ContactFriction:
         """Rates in the friction law: the contact coordinates' (s_dot of Eq. 65)."""
         return np.array([s_idx for _, _, s_idx, _ in self.regions], dtype=int)
 
-    def at_state(self, t, Q, Qd) -> "FrictionAtState":
+    def at_state(self, t, Q, Qd, only=None) -> "FrictionAtState":
         """The friction as a function of the multipliers alone, at the state (Q, Qd): the
-        section maps and mu(s_dot) are formed once here, not in every multiplier iteration."""
+        section maps and mu(s_dot) are formed once here, not in every multiplier iteration.
+        ``only``: indices of the regions to include (default all)."""
         rows = self.ts.rows
         regions = []
-        for name, point, s_idx, geom in self.regions:
+        chosen = self.regions if only is None else [self.regions[k] for k in only]
+        for name, point, s_idx, geom in chosen:
             rp, ra = rows[name + "_point"], rows[name + "_angles"]
             Lf, Lm = section_reaction_maps(point, Q, self.basis, ra.stop - ra.start)
             regions.append((name, s_idx, rp, ra, Lf, Lm, self.law.mu(float(Qd[s_idx])), geom))
@@ -103,12 +105,24 @@ class ContactFriction:
         (name, s_index, mu, N) with the transverse resultant N in N (distribution off)."""
         return self.at_state(0.0, Q, Qd).solve_regions(lam)
 
-    def forces(self, t, Q, Qd, lam):
-        """Generalized friction forces (N, on the contact coordinates), length of Q."""
-        at = self.at_state(t, Q, Qd)
+    def forces(self, t, Q, Qd, lam, only=None):
+        """Generalized friction forces (N, on the contact coordinates), length of Q; ``only``:
+        the regions to include (default all)."""
+        at = self.at_state(t, Q, Qd, only)
         dF = np.zeros(len(Q))
         np.add.at(dF, at.coords, at.values(lam)[0])
         return dF
+
+    def pieces(self):
+        """The friction split by region for the structured Jacobian: (coords(Q), velocity
+        coordinates, forces(t, Q, Qd, lam)) per region, so that a column re-solves only the
+        regions whose contact point depends on it."""
+        out = []
+        for k, (_, point, s_idx, _) in enumerate(self.regions):
+            out.append((lambda Q, point=point: dependencies([point], Q),
+                        np.array([s_idx], dtype=int),
+                        lambda t, Q, Qd, lam, k=k: self.forces(t, Q, Qd, lam, only=(k,))))
+        return out
 
 
 class FrictionAtState:

@@ -157,7 +157,16 @@ def state_jacobian(model, t: float, y: np.ndarray, rel_step: float = REL_STEP,
 
     # friction forces (Section 8.3); their multiplier derivative is formed below (analytic where
     # the force offers at_state, by differences otherwise)
+    # (per region where the force offers pieces(): a column re-solves only the regions whose
+    # contact point depends on it)
     for mf in model.multiplier_forces:
+        if hasattr(mf, "pieces"):
+            for coords, vcols, forces in mf.pieces():
+                c = coords(Q)
+                pieces.append((np.arange(N) if c is None else np.asarray(c, dtype=int), vcols,
+                               lambda Qx, Qdx, forces=forces: (forces(t, Qx, Qdx, lam), None),
+                               None))
+            continue
         pieces.append((cols_of(mf), cols_of(mf, "velocity_coords"),
                        lambda Qx, Qdx, mf=mf: (mf.forces(t, Qx, Qdx, lam), None), None))
 
