@@ -113,16 +113,28 @@ class ContactFriction:
         np.add.at(dF, at.coords, at.values(lam)[0])
         return dF
 
-    def pieces(self):
-        """The friction split by region for the structured Jacobian: (coords(Q), velocity
-        coordinates, forces(t, Q, Qd, lam)) per region, so that a column re-solves only the
-        regions whose contact point depends on it."""
-        out = []
-        for k, (_, point, s_idx, _) in enumerate(self.regions):
-            out.append((lambda Q, point=point: dependencies([point], Q),
-                        np.array([s_idx], dtype=int),
-                        lambda t, Q, Qd, lam, k=k: self.forces(t, Q, Qd, lam, only=(k,))))
-        return out
+    def pieces(self) -> list["FrictionRegion"]:
+        """The friction split by region for the structured Jacobian, each with the interface of
+        the whole (coords, velocity_coords, forces), so that a column re-solves only the regions
+        whose contact point depends on it."""
+        return [FrictionRegion(self, k) for k in range(len(self.regions))]
+
+
+class FrictionRegion:
+    """The friction of one contact region of a :class:`ContactFriction`."""
+
+    def __init__(self, owner: ContactFriction, k: int):
+        self.owner, self.k = owner, k
+        _, self.point, self.s_index, _ = owner.regions[k]
+
+    def coords(self, Q):
+        return dependencies([self.point], Q)
+
+    def velocity_coords(self, Q):
+        return np.array([self.s_index], dtype=int)
+
+    def forces(self, t, Q, Qd, lam):
+        return self.owner.forces(t, Q, Qd, lam, only=(self.k,))
 
 
 class FrictionAtState:

@@ -516,17 +516,16 @@ def angular_momentum(fs: FoldingSystem, Q: np.ndarray, Qd: np.ndarray) -> np.nda
     velocities + rotary inertia), rigid bodies, turntable rotor."""
     m = fs.model
     H = np.zeros(3)
-    for b, off in zip(m.beams, m.offsets):
-        for el, imap in zip(b.elements, b.index_map):
-            kin = el.evaluate(Q[off + imap], strains=False)
-            wl = el.q_w * kin.ell
-            v = np.einsum("gin,n->gi", kin.J_r, Qd[off + imap])
-            w = np.einsum("gin,n->gi", kin.J_w, Qd[off + imap])      # (s, t, b) components
-            fr = kin.sec.frame                                      # rows e_t, e_b, e_s
-            Js = el.section.J
-            hsec = (Js[0] * w[:, 0])[:, None] * fr[:, 2] + (Js[1] * w[:, 1])[:, None] * fr[:, 0] \
-                + (Js[2] * w[:, 2])[:, None] * fr[:, 1]
-            H += np.einsum("g,gi->i", wl, el.section.rhoA * np.cross(kin.r, v) + hsec)
+    for el, idx in m.element_indices():
+        kin = el.evaluate(Q[idx], strains=False)
+        wl = el.q_w * kin.ell
+        v = np.einsum("gin,n->gi", kin.J_r, Qd[idx])
+        w = np.einsum("gin,n->gi", kin.J_w, Qd[idx])      # (s, t, b) components
+        fr = kin.sec.frame                                      # rows e_t, e_b, e_s
+        Js = el.section.J
+        hsec = (Js[0] * w[:, 0])[:, None] * fr[:, 2] + (Js[1] * w[:, 1])[:, None] * fr[:, 0] \
+            + (Js[2] * w[:, 2])[:, None] * fr[:, 1]
+        H += np.einsum("g,gi->i", wl, el.section.rhoA * np.cross(kin.r, v) + hsec)
     for pe in m.point_effects:
         if isinstance(pe, RigidBody):
             H += pe.momentum(Q, Qd)[1]

@@ -111,21 +111,30 @@ class Model:
         return z, zd
 
     # -- assembly --------------------------------------------------------------------------
-    def element_contexts(self, t: float, Q: np.ndarray, Qd: np.ndarray):
-        """Yield (global indices, ElementContext) for every element; kinematics computed once."""
+    def element_indices(self):
+        """Yield (element, its global coordinate indices) for every element of every beam."""
         for b, off in zip(self.beams, self.offsets):
             for el, imap in zip(b.elements, b.index_map):
-                idx = off + imap
-                yield idx, self.element_context(t, el, Q[idx], Qd[idx])
+                yield el, off + imap
+
+    def element_contexts(self, t: float, Q: np.ndarray, Qd: np.ndarray):
+        """Yield (global indices, ElementContext) for every element; kinematics computed once."""
+        for el, idx in self.element_indices():
+            yield idx, self.element_context(t, el, Q[idx], Qd[idx])
+
+    def element_kinematics(self, el, qe: np.ndarray):
+        """Position-level kinematics of one element with the strains the effects declare in
+        ``needs``."""
+        return el.evaluate(qe, strains="strains" in self.needs,
+                           material_strain="material_strain" in self.needs)
 
     def element_context(self, t: float, el, qe: np.ndarray, qde: np.ndarray,
                         kin=None) -> ElementContext:
         """Kinematics of one element with the quantities the effects declare in ``needs``
         (``kin``: the position-level kinematics at qe, if already at hand)."""
-        strains = "strains" in self.needs
         mat = "material_strain" in self.needs
         if kin is None:
-            kin = el.evaluate(qe, strains=strains, material_strain=mat)
+            kin = self.element_kinematics(el, qe)
         ctx = ElementContext(t, el, qe, qde, kin, el.q_w * kin.ell)
         if "convective" in self.needs:
             kc = el.evaluate(qe + 1j * _CSTEP * qde, s=kin.s, sub=kin.sub,
@@ -158,6 +167,11 @@ class Model:
             return element_compiled.element_mass_force(el, qe, qde, needs_mass=mass, **kw)
         return self.element_mass_force(self.element_context(t, el, qe, qde, kin), mass)
 
+    def element_terms_compiled(self, el) -> bool:
+        """True where :meth:`element_terms` of this element takes the compiled kernel (for real
+        states)."""
+        return element_compiled.AVAILABLE and self._compiled_effects(el.section) is not None
+
     def _compiled_effects(self, section):
         """element_compiled's effect arguments for this section, or None where the kernel does
         not cover the effects.  The verdict and the constant arguments are kept per section and
@@ -188,13 +202,11 @@ class Model:
         N = self.n_coords
         M = np.zeros((N, N)) if mass else None
         F = np.zeros(N)
-        for b, off in zip(self.beams, self.offsets):
-            for el, imap in zip(b.elements, b.index_map):
-                idx = off + imap
-                Me, Fe = self.element_terms(t, el, Q[idx], Qd[idx], mass)
-                if mass:
-                    M[np.ix_(idx, idx)] += Me
-                np.add.at(F, idx, Fe)
+        for el, idx in self.element_indices():
+            Me, Fe = self.element_terms(t, el, Q[idx], Qd[idx], mass)
+            if mass:
+                M[np.ix_(idx, idx)] += Me
+            np.add.at(F, idx, Fe)
         for pl in self.point_loads:
             self._add_point_load(pl, t, Q, F)
         for pe in self.point_effects:
@@ -344,25 +356,24 @@ class Model:
         """Kinetic T (material velocities), strain U and gravity potential V, J."""
         T = U = V = 0.0
         g = np.zeros(3) if gravity is None else np.asarray(gravity, float)
-        for b, off in zip(self.beams, self.offsets):
-            for el, imap in zip(b.elements, b.index_map):
-                qe, qde = Q[off + imap], Qd[off + imap]
-                kin = el.evaluate(qe, strains=True)
-                wl = el.q_w * kin.ell
-                v = np.einsum("gin,n->gi", kin.J_r, qde)
-                w = np.einsum("gin,n->gi", kin.J_w, qde)
-                sec = el.section
-                r = kin.r
-                if sec.has_offset:          # mass centre r + d (SCENARIOS A1), see effects
-                    d_glob = kin.sec.frame[:, 0] * sec.y_c + kin.sec.frame[:, 1] * sec.z_c
-                    ws = w[:, [1, 2, 0]]    # (s, t, b) -> (t, b, s) body components
-                    wxd = np.stack([-sec.z_c * ws[:, 2], sec.y_c * ws[:, 2],
-                                    sec.z_c * ws[:, 0] - sec.y_c * ws[:, 1]], axis=1)
-                    v = v + np.einsum("gji,gj->gi", kin.sec.frame, wxd)
-                    r = r + d_glob
-                T += 0.5 * np.dot(wl, sec.rhoA * np.sum(v * v, axis=1) + w * w @ sec.J)
-                U += np.dot(wl, el.strain_energy_density(kin))
-                V -= np.dot(wl * sec.rhoA, r @ g)
+        for el, idx in self.element_indices():
+            qe, qde = Q[idx], Qd[idx]
+            kin = el.evaluate(qe, strains=True)
+            wl = el.q_w * kin.ell
+            v = np.einsum("gin,n->gi", kin.J_r, qde)
+            w = np.einsum("gin,n->gi", kin.J_w, qde)
+            sec = el.section
+            r = kin.r
+            if sec.has_offset:          # mass centre r + d (SCENARIOS A1), see effects
+                d_glob = kin.sec.frame[:, 0] * sec.y_c + kin.sec.frame[:, 1] * sec.z_c
+                ws = w[:, [1, 2, 0]]    # (s, t, b) -> (t, b, s) body components
+                wxd = np.stack([-sec.z_c * ws[:, 2], sec.y_c * ws[:, 2],
+                                sec.z_c * ws[:, 0] - sec.y_c * ws[:, 1]], axis=1)
+                v = v + np.einsum("gji,gj->gi", kin.sec.frame, wxd)
+                r = r + d_glob
+            T += 0.5 * np.dot(wl, sec.rhoA * np.sum(v * v, axis=1) + w * w @ sec.J)
+            U += np.dot(wl, el.strain_energy_density(kin))
+            V -= np.dot(wl * sec.rhoA, r @ g)
         return {"T": float(T), "U": float(U), "V": float(V)}
 
     # -- points ------------------------------------------------------------------------------

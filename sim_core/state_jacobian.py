@@ -84,26 +84,23 @@ def state_jacobian(model, t: float, y: np.ndarray, rel_step: float = REL_STEP,
     # elements: F_e(q_e, qd_e) - M_e(q_e) qdd_e in the element's own coordinates; the rate
     # columns skip the mass matrix (M_e does not depend on rates), and on the numpy path reuse
     # the position-level kinematics
-    for b, off in zip(model.beams, model.offsets):
-        for el, imap in zip(b.elements, b.index_map):
-            idx = off + imap
-            qdde = Qdd[idx]
-            qe, qde = Q[idx].copy(), Qd[idx].copy()
-            kin0 = el.evaluate(qe, strains="strains" in model.needs,
-                               material_strain="material_strain" in model.needs)
+    for el, idx in model.element_indices():
+        qdde = Qdd[idx]
+        qe, qde = Q[idx].copy(), Qd[idx].copy()
+        kin0 = None if model.element_terms_compiled(el) else model.element_kinematics(el, qe)
 
-            def by_position(el=el, qe=qe, qde=qde, qdde=qdde):
-                Me, Fe = model.element_terms(t, el, qe, qde)
-                return Fe - Me @ qdde
+        def by_position(el=el, qe=qe, qde=qde, qdde=qdde):
+            Me, Fe = model.element_terms(t, el, qe, qde)
+            return Fe - Me @ qdde
 
-            def by_rate(el=el, qe=qe, qde=qde, kin=kin0):
-                return model.element_terms(t, el, qe, qde, mass=False, kin=kin)[1]
+        def by_rate(el=el, qe=qe, qde=qde, kin=kin0):
+            return model.element_terms(t, el, qe, qde, mass=False, kin=kin)[1]
 
-            cols = np.arange(len(idx))
-            dR1[np.ix_(idx, idx)] += _difference(by_position, qe, cols, rel_step, central)
-            dR1[np.ix_(idx, N + idx)] += _difference(by_rate, qde, cols, rel_step, central)
-            n_el += 1
-            el_evals += (4 if central else 2) * len(idx) + 1
+        cols = np.arange(len(idx))
+        dR1[np.ix_(idx, idx)] += _difference(by_position, qe, cols, rel_step, central)
+        dR1[np.ix_(idx, N + idx)] += _difference(by_rate, qde, cols, rel_step, central)
+        n_el += 1
+        el_evals += (4 if central else 2) * len(idx) + 1
 
     # pieces acting through points (point loads, payload, ropes, constraints, friction): each
     # says which coordinates it depends on; they are differenced column by column together, so
@@ -155,20 +152,13 @@ def state_jacobian(model, t: float, y: np.ndarray, rel_step: float = REL_STEP,
         _, Jc = c.evaluate(Q + 1j * _H * Qd)
         dR2[sl, N:] += 2.0 * np.imag(Jc) / _H + 2.0 * xi1 * np.real(J)
 
-    # friction forces (Section 8.3); their multiplier derivative is formed below (analytic where
-    # the force offers at_state, by differences otherwise)
-    # (per region where the force offers pieces(): a column re-solves only the regions whose
-    # contact point depends on it)
+    # friction forces (Section 8.3), split into the parts the force offers (friction: one per
+    # contact region, so a column re-solves only the regions whose contact point depends on it);
+    # their multiplier derivative is formed below (analytic where the force offers at_state)
     for mf in model.multiplier_forces:
-        if hasattr(mf, "pieces"):
-            for coords, vcols, forces in mf.pieces():
-                c = coords(Q)
-                pieces.append((np.arange(N) if c is None else np.asarray(c, dtype=int), vcols,
-                               lambda Qx, Qdx, forces=forces: (forces(t, Qx, Qdx, lam), None),
-                               None))
-            continue
-        pieces.append((cols_of(mf), cols_of(mf, "velocity_coords"),
-                       lambda Qx, Qdx, mf=mf: (mf.forces(t, Qx, Qdx, lam), None), None))
+        for part in (mf.pieces() if hasattr(mf, "pieces") else [mf]):
+            pieces.append((cols_of(part), cols_of(part, "velocity_coords"),
+                           lambda Qx, Qdx, part=part: (part.forces(t, Qx, Qdx, lam), None), None))
 
     base = [None if central else fun(Q, Qd) for _, _, fun, _ in pieces]
     for which, x in enumerate((Q, Qd)):

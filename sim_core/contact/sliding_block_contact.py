@@ -424,7 +424,8 @@ class ContactSolution:
         (the friction load of Eq. 65) follows the section load at fixed mu; f_c,s does not
         enter.  Implicit function theorem on Eqs. 67-71: dx/dc = -J^-1, so
         dN/dc = -(J^-T A^T f')^T.  Rigid-motion directions that compress no active spring do
-        not change any force and are removed by a least-squares solve.  (5,), 1 and 1/m."""
+        not change any force; the solve keeps them regular (see _load_sensitivity).  (5,), 1
+        and 1/m."""
         return -self._load_sensitivity()
 
     def _load_sensitivity(self) -> np.ndarray:
