@@ -50,8 +50,12 @@ class NonlinearConstraint:
         return None if self.points is None else dependencies(self.points, Q)
 
     def b(self, t: float):
+        """(b, b_dot, b_ddot) at t (zeros without a target)."""
         if self.target is None:
-            z = np.zeros(self.m)
+            z = self.__dict__.get("_zeros")
+            if z is None:
+                z = self._zeros = np.zeros(self.m)
+                z.flags.writeable = False
             return z, z, z
         return tuple(np.atleast_1d(np.asarray(x, float)) for x in self.target(t))
 
@@ -80,8 +84,8 @@ def constraint_terms(cons: list[NonlinearConstraint], t: float, Q: Vec, Qd: Vec)
     phis, jacs, dphis, rhs = [], [], [], []
     Qc = Q + 1j * _H * Qd                  # one complex state: the point caches serve all rows
     for c in cons:
+        _, Jc = c.evaluate(Qc)             # first: the real evaluation is then its real part
         g, J = c.evaluate(Q)
-        _, Jc = c.evaluate(Qc)
         quad = (Jc @ Qd).imag / _H
         b, bd, bdd = c.b(t)
         phis.append(np.real(g) - b)
@@ -91,8 +95,19 @@ def constraint_terms(cons: list[NonlinearConstraint], t: float, Q: Vec, Qd: Vec)
     return (np.concatenate(phis), np.vstack(jacs), np.concatenate(dphis), np.concatenate(rhs))
 
 
-def kkt_factor(Mr: Vec, C: Vec):
-    """LU-factor the saddle-point matrix once; returns solve(Fr, c_rhs) -> (z_ddot, lambda)."""
+def kkt_factor(Mr: Vec, C: Vec, blocks=None):
+    """Factor the saddle-point matrix once; returns solve(Fr, c_rhs) -> (z_ddot, lambda)
+    (Fr, c_rhs: vectors or matrices of right-hand sides).
+
+    ``blocks``: index arrays of diagonal blocks of Mr that the caller guarantees uncoupled
+    (Mr[b_i, b_j] = 0 for i != j; couplings to the coordinates outside every block are allowed),
+    e.g. the beams of ``Model`` (``Model._reduced_mass_force_at``).  Then the system is solved
+    by block elimination (:func:`_kkt_factor_blocks`); where a block is not positive definite,
+    by the LU of the whole matrix (the reference)."""
+    if blocks is not None:
+        solve = _kkt_factor_blocks(Mr, C, blocks)
+        if solve is not None:
+            return solve
     import scipy.linalg as sla
     n, m = Mr.shape[0], C.shape[0]
     K = np.zeros((n + m, n + m))
@@ -104,6 +119,74 @@ def kkt_factor(Mr: Vec, C: Vec):
     def solve(Fr, c_rhs):
         sol = sla.lu_solve(lu, np.concatenate([Fr, c_rhs]))
         return sol[:n], -sol[n:]
+    return solve
+
+
+def _kkt_factor_blocks(Mr: Vec, C: Vec, blocks, refine: bool = True):
+    """Block elimination of  [[Mr, C^T], [C, 0]] [z; mu] = [F; c]  over SPD diagonal blocks.
+
+    Unknowns ordered (x_1 .. x_k | w) with x_i = z[b_i] and the border w = (z[r], mu), r the
+    coordinates in no block (e.g. the massless contact coordinates).  With A_i = Mr[b_i, b_i]
+    (Cholesky), B_i = [Mr[b_i, r], C[:, b_i]^T] and the border block D = [[Mr[r, r], C[:, r]^T],
+    [C[:, r], 0]], the Schur complement  S = D - sum_i B_i^T A_i^-1 B_i  (LU with pivoting, the
+    size of the border: ~33 for the telescopic scene against 344 for the whole matrix) gives
+    w = S^-1 (g - sum_i B_i^T A_i^-1 f_i),  x_i = A_i^-1 (f_i - B_i w).  The elimination is not
+    backward stable for ill-conditioned A_i (the filter's mass (h^2/6) K makes cond ~1e11), so
+    every solve takes one step of iterative refinement on the whole system, which brings the
+    residual to that of the whole-matrix LU (tests/beam/test_nonlinear_constraints.py;
+    ``refine=False`` skips it, for that test).
+    Only the columns of B_i that are not zero (the constraints that act on body i) enter the
+    products.  Returns None where a block is not positive definite."""
+    from scipy.linalg import lapack
+    n, m = Mr.shape[0], C.shape[0]
+    mask = np.ones(n, dtype=bool)
+    for b in blocks:
+        mask[b] = False
+    r = np.flatnonzero(mask)
+    facs, Bs, Ys = [], [], []
+    nb = len(r) + m
+    S = np.zeros((nb, nb))
+    S[:len(r), :len(r)] = Mr[np.ix_(r, r)]
+    S[:len(r), len(r):] = C[:, r].T
+    S[len(r):, :len(r)] = C[:, r]
+    for b in blocks:
+        c, info = lapack.dpotrf(Mr[np.ix_(b, b)], lower=1, clean=0, overwrite_a=1)
+        if info != 0:
+            return None                 # not positive definite (a massless body)
+        B = np.hstack([Mr[np.ix_(b, r)], C[:, b].T])
+        cols = np.flatnonzero(np.any(B != 0.0, axis=0))
+        B = B[:, cols]
+        Y, info = lapack.dpotrs(c, B, lower=1)
+        facs.append(c)
+        Bs.append((cols, B))
+        Ys.append(Y)
+        S[np.ix_(cols, cols)] -= B.T @ Y
+    lu, piv, info = lapack.dgetrf(S)
+    if info != 0:
+        return None
+
+    def once(F, c_rhs):
+        g = np.concatenate([F[r], c_rhs])
+        us = []
+        for b, c, (cols, B) in zip(blocks, facs, Bs):
+            u, _ = lapack.dpotrs(c, F[b], lower=1)
+            us.append(u)
+            g[cols] -= B.T @ u
+        w, _ = lapack.dgetrs(lu, piv, g)
+        z = np.empty_like(F)
+        z[r] = w[:len(r)]
+        for b, u, (cols, _), Y in zip(blocks, us, Bs, Ys):
+            z[b] = u - Y @ w[cols]
+        return z, w[len(r):]
+
+    def solve(Fr, c_rhs):
+        Fr = np.asarray(Fr, dtype=float)
+        c_rhs = np.asarray(c_rhs, dtype=float)
+        z, mu = once(Fr, c_rhs)
+        if refine:
+            dz, dmu = once(Fr - Mr @ z - C.T @ mu, c_rhs - C @ z)
+            z, mu = z + dz, mu + dmu
+        return z, -mu
     return solve
 
 
@@ -139,25 +222,34 @@ def material_point(model, ibeam: int, s_fixed: float | None = None, s_index: int
     off = int(model.offsets[ibeam])
     N = model.n_coords
 
-    # [(coordinates, their values, result)] for the last real and the last complex state; keyed
-    # on the coordinates the point depends on, so a state that differs elsewhere (another
-    # body's coordinate perturbed for a Jacobian column) reuses the evaluation
-    memo: list = []
+    # the last real and the last complex evaluation, keyed on the coordinates the point depends
+    # on and their values, so a state that differs elsewhere (another body's coordinate
+    # perturbed for a Jacobian column) reuses the evaluation.  The real part of a complex-step
+    # evaluation is the real evaluation (to O(h^2) = 1e-40 relative, far below round-off): a
+    # real state equal to the real part of the last complex one is served from it, so the
+    # constraint rows, which need both, evaluate the point once
+    memo: dict = {}
 
     def f(Q):
-        cols = coords(Q)
-        key = (cols.tobytes(), Q[cols].tobytes())     # exact: the same coordinates and values
-        for k, dt, res in memo:
-            if dt == Q.dtype and k == key:
+        e, idx, cols = locate(Q)
+        vals = Q[cols]
+        key = (cols.tobytes(), vals.tobytes())
+        kind = Q.dtype.kind
+        hit = memo.get(kind)
+        if hit is not None and hit[0] == key:
+            return hit[1]
+        if kind != "c":
+            hit = memo.get("c")
+            if hit is not None and hit[2] == key:
+                res = tuple(np.ascontiguousarray(x.real) for x in hit[1])
+                memo[kind] = (key, res)
                 return res
-        res = _evaluate(Q)
-        memo[:] = [m for m in memo if m[1] != Q.dtype][:1] + [(key, Q.dtype, res)]
+        res = _evaluate(Q, e, idx)
+        memo[kind] = (key, res, (key[0], vals.real.tobytes()) if kind == "c" else None)
         return res
 
-    def _evaluate(Q):
+    def _evaluate(Q, e, idx):
         s = Q[s_index] if s_index is not None else s_fixed
-        e = model._element_at(ibeam, Q.real, float(np.real(s)))
-        idx = off + beam.index_map[e]
         el = beam.elements[e]
         if point_compiled.AVAILABLE:                      # the same kinematics, compiled
             r, rp, J_r, J_psi, angles, psi_prime, frame, tmat = point_compiled.point_kinematics(
@@ -185,11 +277,17 @@ def material_point(model, ibeam: int, s_fixed: float | None = None, s_index: int
             r = r + o
         return r, J, angles, Jp
 
+    def locate(Q):
+        """(element, its global indices, the coordinates r and Psi depend on at Q: the
+        element's, and s_index if moving)."""
+        s = np.real(Q[s_index]) if s_index is not None else s_fixed
+        e = model._element_at(ibeam, Q, float(s))
+        idx = off + beam.index_map[e]
+        return e, idx, (idx if s_index is None else np.append(idx, s_index))
+
     def coords(Q):
         """The coordinates r and Psi depend on at Q: the element's, and s_index if moving."""
-        s = np.real(Q[s_index]) if s_index is not None else s_fixed
-        idx = off + beam.index_map[model._element_at(ibeam, np.real(Q), float(s))]
-        return idx if s_index is None else np.append(idx, s_index)
+        return locate(Q)[2]
 
     f.coords = coords
     cache[key] = f

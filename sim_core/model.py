@@ -16,6 +16,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from .beam import element_compiled
+from .assembly_compiled import scatter_add
 from .beam.moving_node_beam import Beam
 from .constraints import constraint_terms, kkt_accelerations, kkt_factor
 from .effects import Effect, ElementContext, Gravity, PointLoad, StressFilter
@@ -62,6 +63,9 @@ class Model:
     multiplier_newton: bool = True     # False: the fixed point even where at_state is offered
     multiplier_max_iter: int = 8
     baumgarte: tuple[float, float] = (10.0, 10.0)          # xi1, xi2 in 1/s (second seed Eq. 8)
+    # the saddle-point system by block elimination over the beams (constraints.kkt_factor)
+    # where M_r is block-diagonal in them; False: the LU of the whole matrix (the reference)
+    kkt_blocks: bool = True
 
     def __post_init__(self):
         self.offsets = np.cumsum([0] + [b.n_coords for b in self.beams])[:-1]
@@ -100,9 +104,18 @@ class Model:
 
     def full_state(self, t: float, z: np.ndarray, zd: np.ndarray):
         """Q, Q_dot from the reduced state."""
-        Q = self.A_pinv @ self._b(t, 0) + self.P @ z
-        Qd = self.A_pinv @ self._b(t, 1) + self.P @ zd
-        return Q, Qd
+        return self._lift(t, z, 0), self._lift(t, zd, 1)
+
+    def _lift(self, t: float, x: np.ndarray, which: int) -> np.ndarray:
+        """A^+ b^(which)(t) + P x (which = 0, 1, 2: position, rate, acceleration level); P x as
+        a signed scatter where P only selects coordinates."""
+        X = self.A_pinv @ self._b(t, which)
+        if self._sel is None:
+            return X + self.P @ x
+        rows, sgn, _ = self._sel
+        X = X.astype(np.result_type(X, x), copy=False)
+        X[rows] += sgn * x
+        return X
 
     def reduced_state(self, t: float, Q: np.ndarray, Qd: np.ndarray):
         """Project a full state onto the constraint manifold's coordinates (z, z_dot)."""
@@ -200,52 +213,128 @@ class Model:
     def mass_force(self, t: float, Q: np.ndarray, Qd: np.ndarray, mass: bool = True):
         """Full-coordinate mass matrix (or None) and force vector: M Q_ddot = F."""
         N = self.n_coords
-        M = np.zeros((N, N)) if mass else None
-        F = np.zeros(N)
-        for el, idx in self.element_indices():
-            Me, Fe = self.element_terms(t, el, Q[idx], Qd[idx], mass)
-            if mass:
-                M[np.ix_(idx, idx)] += Me
-            np.add.at(F, idx, Fe)
-        for pl in self.point_loads:
-            self._add_point_load(pl, t, Q, F)
-        for pe in self.point_effects:
+        dt = np.result_type(Q, Qd, float)
+        M = np.zeros((N, N), dtype=dt) if mass else None
+        F = np.zeros(N, dtype=dt)
+        full = self.__dict__.get("_full_map")
+        if full is None:
+            full = self._full_map = (np.arange(N), np.ones(N))
+        rest, _ = self._scatter_local_terms(t, Q, Qd, M, F, *full)
+        for pe in rest:
             pe.add(t, Q, Qd, M, F)
         return M, F
 
+    def _scatter_local_terms(self, t, Q, Qd, M, F, red, sg, Qdd_p=None) -> list:
+        """Add every element's, point load's and local point effect's (Me, Fe) into (M, F)
+        through the coordinate map (red, sg) (:func:`assembly_compiled.scatter_add`); with
+        ``Qdd_p`` the force is F - M Qdd_p.  Returns the point effects without a local form
+        (``local(t, Q, Qd, mass) -> (idx, Me, Fe)``), for the caller to add on full arrays,
+        and whether a point effect's mass couples two beams (elements never do)."""
+        mass = M is not None
+        coupled = False
+
+        def put(idx, Me, Fe):
+            if Qdd_p is not None and Me is not None:
+                Fe = Fe - Me @ Qdd_p[idx]
+            scatter_add(M, F, red, sg, idx, Me, Fe)
+
+        for el, idx in self.element_indices():
+            put(idx, *self.element_terms(t, el, Q[idx], Qd[idx], mass))
+        for pl in self.point_loads:
+            put(*self._point_load_terms(pl, t, Q))
+        rest = []
+        for pe in self.point_effects:
+            if hasattr(pe, "local"):
+                idx, Me, Fe = pe.local(t, Q, Qd, mass)
+                if Me is not None and not coupled:
+                    o = self._beam_of()[idx]
+                    o = o[o >= 0]
+                    coupled = o.size > 0 and o.min() != o.max()
+                put(idx, Me, Fe)
+            else:
+                rest.append(pe)
+        return rest, coupled
+
+    def _beam_of(self) -> np.ndarray:
+        """The beam of each coordinate (-1: an extra coordinate)."""
+        owner = self.__dict__.get("_owner")
+        if owner is None:
+            owner = self._owner = np.full(self.n_coords, -1)
+            for b, (off, beam) in enumerate(zip(self.offsets, self.beams)):
+                owner[off:off + beam.n_coords] = b
+        return owner
+
     def _add_point_load(self, pl: PointLoad, t: float, Q: np.ndarray, F: np.ndarray) -> None:
+        idx, _, Fe = self._point_load_terms(pl, t, Q)
+        F[idx] += Fe
+
+    def _point_load_terms(self, pl: PointLoad, t: float, Q: np.ndarray):
+        """(idx, None, Fe): J_r^T f (+ J_w^T moment) of a point load at its element."""
         beam = self.beams[pl.beam]
         off = self.offsets[pl.beam]
         s = float(pl.s_of_t(t))
         e = self._element_at(pl.beam, Q, s)
         idx = off + beam.index_map[e]
         kin = beam.elements[e].evaluate(Q[idx], s=np.array([s]), strains=False)
-        F[idx] += kin.J_r[0].T @ np.asarray(pl.force(t), float)
+        Fe = kin.J_r[0].T @ np.asarray(pl.force(t), float)
         if pl.moment is not None:
-            F[idx] += kin.J_w[0].T @ np.asarray(pl.moment(t), float)
+            Fe = Fe + kin.J_w[0].T @ np.asarray(pl.moment(t), float)
+        return idx, None, Fe
 
     def _element_at(self, ibeam: int, Q: np.ndarray, s: float) -> int:
-        beam = self.beams[ibeam]
-        off = self.offsets[ibeam]
-        for e in range(len(beam.elements) - 1):
-            if s < Q[off + beam.s_coord(e + 1)]:
+        """The element of beam ``ibeam`` that holds material coordinate s at Q (by the real
+        parts of its interior breakpoints' coordinates)."""
+        table = self.__dict__.get("_interior_s")
+        if table is None:
+            table = self._interior_s = [
+                [int(off + b.s_coord(e + 1)) for e in range(len(b.elements) - 1)]
+                for b, off in zip(self.beams, self.offsets)]
+        for e, j in enumerate(table[ibeam]):
+            if s < Q[j].real:
                 return e
-        return len(beam.elements) - 1
+        return len(table[ibeam])
 
     # -- reduced dynamics ------------------------------------------------------------------
     def reduced_mass_force(self, t: float, z: np.ndarray, zd: np.ndarray):
+        """(M_r, F_r) = (P^T M P, P^T (F - M Qdd_p)): the reduced system M_r z_ddot = F_r."""
         Q, Qd = self.full_state(t, z, zd)
-        M, F = self.mass_force(t, Q, Qd)
-        Qdd_p = self.A_pinv @ self._b(t, 2)
-        if self._sel is not None:
-            # P selects (and signs) coordinates, the usual case of boundary conditions that fix
-            # single coordinates: P^T M P is a sub-matrix (two dense products of the N x N mass
-            # matrix were ~1/4 of a telescopic right-hand side at 8 sub-elements)
-            rows, sgn, sgn2 = self._sel
-            return M[np.ix_(rows, rows)] * sgn2, sgn * (F - M @ Qdd_p)[rows]
-        Mr = self.P.T @ M @ self.P
-        Fr = self.P.T @ (F - M @ Qdd_p)
-        return Mr, Fr
+        return self._reduced_mass_force_at(t, Q, Qd, self.A_pinv @ self._b(t, 2))
+
+    def _reduced_mass_force_at(self, t, Q, Qd, Qdd_p, blocks: bool = False):
+        """(M_r, F_r) at the full state; ``blocks``: and the reduced coordinates of each beam
+        where M_r is block-diagonal in them (no point effect's mass couples two beams), else
+        None (for ``constraints.kkt_factor``)."""
+        if self._sel is None:
+            M, F = self.mass_force(t, Q, Qd)
+            out = self.P.T @ M @ self.P, self.P.T @ (F - M @ Qdd_p)
+            return out + (None,) if blocks else out
+        # P selects (and signs) coordinates, the usual case of boundary conditions that fix
+        # single coordinates: the blocks go straight into P^T M P (assembly_compiled)
+        rows, sgn, sgn2 = self._sel
+        red = self.__dict__.get("_red_map")
+        if red is None:
+            owner = self._beam_of()[rows]
+            red = self._red_map = (np.full(self.n_coords, -1), np.zeros(self.n_coords),
+                                   [np.flatnonzero(owner == b) for b in range(len(self.beams))])
+            red[0][rows] = np.arange(len(rows))
+            red[1][rows] = sgn
+        n = len(rows)
+        dt = np.result_type(Q, Qd, float)
+        Mr = np.zeros((n, n), dtype=dt)
+        Fr = np.zeros(n, dtype=dt)
+        rest, coupled = self._scatter_local_terms(t, Q, Qd, Mr, Fr, *red[:2],
+                                                  Qdd_p=Qdd_p if np.any(Qdd_p) else None)
+        if rest:
+            N = self.n_coords
+            M, F = np.zeros((N, N), dtype=dt), np.zeros(N, dtype=dt)
+            for pe in rest:
+                pe.add(t, Q, Qd, M, F)
+            Mr += M[np.ix_(rows, rows)] * sgn2
+            Fr += sgn * (F - M @ Qdd_p)[rows]
+            coupled = True                      # unknown where the mass went
+        if not blocks:
+            return Mr, Fr
+        return Mr, Fr, (None if coupled else red[2])
 
     @property
     def n(self) -> int:
@@ -261,17 +350,17 @@ class Model:
 
     def accelerations_and_multipliers(self, t: float, z: np.ndarray, zd: np.ndarray):
         """z_ddot and the multipliers of the nonlinear constraints (empty if there are none)."""
-        Mr, Fr = self.reduced_mass_force(t, z, zd)
+        Q, Qd = self.full_state(t, z, zd)
+        Qdd_p = self.A_pinv @ self._b(t, 2)
+        Mr, Fr, blocks = self._reduced_mass_force_at(t, Q, Qd, Qdd_p, blocks=True)
         if not self.nonlinear:
             return sla.solve(Mr, Fr, assume_a="pos"), np.zeros(0)
-        Q, Qd = self.full_state(t, z, zd)
         phi, J, dphi, c_rhs = constraint_terms(self.nonlinear, t, Q, Qd)
         xi1, xi2 = self.baumgarte
-        Qdd_p = self.A_pinv @ self._b(t, 2)
         c_rhs = c_rhs - J @ Qdd_p - 2.0 * xi1 * dphi - xi2 ** 2 * phi
         if not self.multiplier_forces:
             return kkt_accelerations(Mr, Fr, J @ self.P, c_rhs)
-        solve = kkt_factor(Mr, J @ self.P)
+        solve = kkt_factor(Mr, J @ self.P, blocks if self.kkt_blocks else None)
         if self.multiplier_newton and all(hasattr(mf, "at_state") for mf in self.multiplier_forces):
             return self._multiplier_newton(t, Q, Qd, solve, Fr, c_rhs)
         zdd, lam = solve(Fr, c_rhs)

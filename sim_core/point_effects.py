@@ -35,16 +35,20 @@ class PointMass:
         """Coordinates whose rates enter the force (the point's: the convective term)."""
         return self.coords(Q)
 
-    def add(self, t, Q, Qd, M, F):
+    def local(self, t, Q, Qd, mass=True):
+        """(idx, Me (or None), Fe) on the coordinates the point depends on."""
+        idx = _cols(self.coords(Q), Q)
+        _, Jc, _, _ = self.point(Q + 1j * _H * Qd)     # first: the real one is its real part
         _, J, _, _ = self.point(Q)
-        _, Jc, _, _ = self.point(Q + 1j * _H * Qd)
-        acc = (Jc @ Qd).imag / _H
-        if M is not None:
-            M += self.mass * (J.T @ J)
+        J = J[:, idx]
+        acc = (Jc[:, idx] @ Qd[idx]).imag / _H
         f = -self.mass * acc
         if self.gravity is not None:
             f = f + self.mass * self.gravity
-        F += J.T @ f
+        return idx, (self.mass * (J.T @ J) if mass else None), J.T @ f
+
+    def add(self, t, Q, Qd, M, F):
+        _add_local(self.local(t, Q, Qd, M is not None), M, F)
 
 
 @dataclass
@@ -92,6 +96,24 @@ class RopeDrive:
             return k * (ell - self.L0 - 0.5 * self.slack_width)
         return k * self.slack_width * 0.5 * x * x
 
-    def add(self, t, Q, Qd, M, F):
+    def local(self, t, Q, Qd, mass=True):
+        """(idx, None, Fe) on the coordinates the rope's points depend on."""
+        idx = _cols(self.coords(Q), Q)
         ell, grad = self.length(Q)
-        F -= self.tension(float(np.real(ell))) * np.real(grad)
+        return idx, None, -self.tension(float(np.real(ell))) * np.real(grad[idx])
+
+    def add(self, t, Q, Qd, M, F):
+        _add_local(self.local(t, Q, Qd, M is not None), M, F)
+
+
+def _cols(cols, Q) -> np.ndarray:
+    """The coordinates a point effect depends on (all where a point does not say)."""
+    return np.arange(len(Q)) if cols is None else np.asarray(cols, dtype=int)
+
+
+def _add_local(terms, M, F) -> None:
+    """Add a local (idx, Me, Fe) to the full (M, F); idx holds each coordinate once."""
+    idx, Me, Fe = terms
+    F[idx] += Fe
+    if M is not None and Me is not None:
+        M[np.ix_(idx, idx)] += Me

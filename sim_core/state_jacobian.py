@@ -124,8 +124,12 @@ def state_jacobian(model, t: float, y: np.ndarray, rel_step: float = REL_STEP,
 
     for pe in model.point_effects:         # payload, ropes: F_pe - M_pe Q_ddot
         def point_effect(Qx, Qdx, pe=pe):
-            M = np.zeros((N, N))
             F = np.zeros(N)
+            if hasattr(pe, "local"):           # a block on a few coordinates
+                idx, Me, Fe = pe.local(t, Qx, Qdx)
+                F[idx] = Fe if Me is None else Fe - Me @ Qdd[idx]
+                return F, None
+            M = np.zeros((N, N))
             pe.add(t, Qx, Qdx, M, F)
             return F - M @ Qdd, None
         pieces.append((cols_of(pe), cols_of(pe, "velocity_coords"), point_effect, None))
