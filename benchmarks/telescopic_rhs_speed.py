@@ -21,6 +21,15 @@ last evaluation, and a benchmark that repeats one state measures cache hits.  Va
   points (``sim_core.beam.point_compiled``),
 * ``+ compiled elements``     and the element mass matrices and forces
   (``sim_core.beam.element_compiled``),
+* ``+ block saddle-point solve`` and the saddle-point system by block elimination over the
+  beams (``Model.kkt_blocks``; before: the LU of the whole matrix),
+* ``+ compiled scatter``      and the element and point-effect blocks added into the reduced
+  arrays by the compiled loop of ``sim_core.assembly_compiled`` (before: its numpy version),
+
+All variants assemble the reduced system block by block and evaluate each material point once
+for the real and complex-step states (2026-11-24, second session; before, the full N x N mass
+matrix was formed and projected, and every point was evaluated twice; that code's own version
+of this script, run at commit f32e090, wrote ``results/telescopic_rhs_speed_f32e090.md``).
 
 then a cProfile of the last variant, grouped by what the time is spent on.  Ratios within one
 run are what the table is for; the machine may be shared.
@@ -42,6 +51,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..")))
 
+from sim_core import assembly_compiled                        # noqa: E402
 from sim_core.beam import cardan_compiled, element_compiled, point_compiled  # noqa: E402
 from sim_core.contact import micro_motion_compiled            # noqa: E402
 from sim_core.result import atomic_write_bytes                # noqa: E402
@@ -50,29 +60,34 @@ from jacobian_speed import sliding_state                      # noqa: E402  (ben
 OUT = os.path.join(os.path.dirname(__file__), "results", "telescopic_rhs_speed.md")
 
 # (label, multiplier Newton, compiled: section state, micro-motion Newton, point kinematics,
-# element mass and forces)
-VARIANTS = (("fixed point, numpy", False, False, False, False, False),
-            ("Newton, numpy", True, False, False, False, False),
-            ("+ compiled section", True, True, False, False, False),
-            ("+ compiled micro-motion", True, True, True, False, False),
-            ("+ compiled points", True, True, True, True, False),
-            ("+ compiled elements", True, True, True, True, True))
+# element mass and forces, block elimination of the saddle-point system, compiled scatter)
+VARIANTS = (("fixed point, numpy", False, False, False, False, False, False, False),
+            ("Newton, numpy", True, False, False, False, False, False, False),
+            ("+ compiled section", True, True, False, False, False, False, False),
+            ("+ compiled micro-motion", True, True, True, False, False, False, False),
+            ("+ compiled points", True, True, True, True, False, False, False),
+            ("+ compiled elements", True, True, True, True, True, False, False),
+            ("+ block saddle-point solve", True, True, True, True, True, True, False),
+            ("+ compiled scatter", True, True, True, True, True, True, True))
 
-# cProfile groups: (label, function names whose cumulative time is the group's; nested
-# groups are subtracted from their parents below)
+# cProfile groups: (label, "module file:function" names whose cumulative time is the group's;
+# none of them calls another group's functions)
 GROUPS = (
-    ("friction (section maps, micro-motion solves, sensitivities)", ("at_state", "values")),
-    ("constraint rows (Jacobian, quadratic terms)", ("constraint_terms",)),
-    ("saddle-point factorisation", ("kkt_factor",)),
-    ("saddle-point solves", ("lu_solve",)),
-    ("point effects (payload, ropes)", ("add",)),
-    ("elements (kinematics, mass, forces)", ("element_terms",)),
+    ("friction (section maps, micro-motion solves, sensitivities)",
+     ("contact_friction.py:at_state", "contact_friction.py:values")),
+    ("constraint rows (Jacobian, quadratic terms)", ("constraints.py:constraint_terms",)),
+    ("saddle-point factorisation", ("constraints.py:kkt_factor",)),
+    ("saddle-point solves", ("_decomp_lu.py:lu_solve", "constraints.py:once")),
+    ("point effects (payload, ropes)", ("point_effects.py:local",)),
+    ("elements (kinematics, mass, forces)", ("model.py:element_terms",)),
 )
 
 
 def _configure(m, newton: bool, section: bool, micro: bool, points: bool,
-               elements: bool) -> None:
+               elements: bool, blocks: bool, scatter: bool) -> None:
     m.multiplier_newton = newton
+    m.kkt_blocks = blocks
+    assembly_compiled.AVAILABLE = scatter and cardan_compiled.numba is not None
     cardan_compiled.AVAILABLE = section and cardan_compiled.numba is not None
     micro_motion_compiled.AVAILABLE = micro and micro_motion_compiled.numba is not None
     point_compiled.AVAILABLE = points and cardan_compiled.numba is not None
@@ -113,15 +128,14 @@ def profile_groups(m, t, y, calls: int = 40) -> tuple[float, list[tuple[str, flo
     st = pstats.Stats(pr)
     total = 0.0
     cum: dict[str, float] = {}
-    for (_, _, name), (_, _, _, ct, _) in st.stats.items():
-        cum[name] = cum.get(name, 0.0) + ct
-        if name == "rhs":
+    for (path, _, name), (_, _, _, ct, _) in st.stats.items():
+        key = f"{os.path.basename(path)}:{name}"
+        cum[key] = cum.get(key, 0.0) + ct
+        if key == "model.py:rhs":
             total = ct
     rows = []
     for label, names in GROUPS:
         rows.append((label, sum(cum.get(n, 0.0) for n in names)))
-    # point effects' "add" is inside mass_force, not inside the element groups: no overlap;
-    # the friction's "values" calls its own small solves, not lu_solve (the KKT's): no overlap
     rows.append(("rest (state maps, reductions, bookkeeping)", total - sum(v for _, v in rows)))
     return total, rows
 
