@@ -19,6 +19,7 @@ import numpy as np
 from .beam.cardan import cardan_frame
 from .constraints import dependencies
 from .contact import FrictionLaw, SliderGeometry, SpringLaw, solve_micro_motion
+from .contact.sliding_block_contact import newton_matrices, normal_load
 
 
 def section_reaction_maps(point, Q, basis, n_angles: int = 3):
@@ -98,7 +99,7 @@ class ContactFriction:
             rp, ra = rows[name + "_point"], rows[name + "_angles"]
             Lf, Lm = section_reaction_maps(point, Q, self.basis, ra.stop - ra.start)
             regions.append((name, s_idx, rp, ra, Lf, Lm, self.law.mu(float(Qd[s_idx])), geom))
-        return FrictionAtState(self, regions)
+        return FrictionAtState(self, regions, t)
 
     def solve_regions(self, Q, Qd, lam):
         """Per region: (name, s_index, mu, ContactSolution) (distribution on) or
@@ -145,10 +146,15 @@ class FrictionAtState:
     regularised law), that :meth:`sim_core.model.Model.accelerations_and_multipliers` solves
     by Newton in the k values g."""
 
-    def __init__(self, owner: ContactFriction, regions: list):
+    def __init__(self, owner: ContactFriction, regions: list, t: float = float("nan")):
         self.owner = owner
         self.regions = regions
+        self.t = t
         self.coords = np.array([r[1] for r in regions], dtype=int)
+        # the micro-motion Newton's matrices depend on the region and mu(s_dot) only: formed
+        # once per state, not in every friction iteration
+        self._matrices = [None if geom is None else newton_matrices(geom, owner.spring, mu)
+                          for (_, _, _, _, _, _, mu, geom) in regions]
 
     def solve_regions(self, lam):
         out = []
@@ -169,22 +175,23 @@ class FrictionAtState:
         sum (micro-motion solve, Eqs. 59-71) or its transverse resultant |(f_t, f_b)|."""
         g = np.empty(len(self.regions))
         dg = np.zeros((len(self.regions), len(lam))) if gradient else None
-        for r, ((_, _, mu, sol), (_, _, rp, ra, Lf, Lm, _, _)) in enumerate(
-                zip(self.solve_regions(lam), self.regions)):
-            if geom_free(sol):
-                g[r] = -mu * sol
-                if gradient and sol > 0.0:
-                    ftb = Lf[1:3] @ lam[rp]
-                    dg[r, rp] = -mu * (ftb / sol) @ Lf[1:3]
+        x0 = self.owner._x0
+        spring = self.owner.spring
+        for r, ((name, _, rp, ra, Lf, Lm, mu, geom), mats) in enumerate(
+                zip(self.regions, self._matrices)):
+            f_c = Lf @ lam[rp]
+            if geom is None:                           # the transverse resultant
+                N = float(np.hypot(f_c[1], f_c[2]))
+                g[r] = -mu * N
+                if gradient and N > 0.0:
+                    dg[r, rp] = -mu * (f_c[1:3] / N) @ Lf[1:3]
                 continue
-            g[r] = -mu * sol.total_normal_force
+            # Eq. 65's normal load by the micro-motion solve (Eqs. 59-71) and its sensitivity
+            # d N / d(f_t, f_b, m_s, m_t, m_b) (ContactSolution.normal_load_gradient)
+            N, dN, x0[name] = normal_load(geom, spring, f_c, Lm @ lam[ra], mu, *mats,
+                                          x0=x0.get(name), t=self.t)
+            g[r] = -mu * N
             if gradient and mu != 0.0:
-                dN = sol.normal_load_gradient()        # d N / d(f_t, f_b, m_s, m_t, m_b)
                 dg[r, rp] = -mu * (dN[:2] @ Lf[1:3])
                 dg[r, ra] = -mu * (dN[2:] @ Lm)
         return g, dg
-
-
-def geom_free(sol) -> bool:
-    """True for the resultant-only normal load (a float) of ``solve_regions``."""
-    return isinstance(sol, float)

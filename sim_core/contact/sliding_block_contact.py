@@ -509,6 +509,69 @@ def _cold_start(geom: SliderGeometry, spring: SpringLaw, c5: np.ndarray) -> np.n
     return lam * x_lin
 
 
+def newton_matrices(geom: SliderGeometry, spring: SpringLaw, mu: float):
+    """(G^T, kappa (A^T A + mu Bf^T A)) of the micro-motion Newton at friction coefficient mu:
+    R = c + G^T f(A x) with G = A + mu Bf (Eqs. 67-71), and the Newton matrix's stiffness
+    floor.  They depend on the region and mu only (FrictionAtState forms them once per state)."""
+    GT = geom.AT + mu * geom.BfT if mu != 0.0 else geom.AT
+    return GT, (_KAPPA * spring.k0) * (geom.AtA + mu * geom.BftA)
+
+
+def _load_vector(geom: SliderGeometry, f_c, m_c, mu: float, t: float):
+    """(c (5,), row scales S (5,), load scale) of Eqs. 67-71, ordered like x:
+    (f_t, f_b, m_s, m_t, m_b) equations; moments scaled by 1/length_scale."""
+    fs, ft, fb = float(f_c[0]), float(f_c[1]), float(f_c[2])
+    ms, mt, mb = float(m_c[0]), float(m_c[1]), float(m_c[2])
+    if not all(map(math.isfinite, (fs, ft, fb, ms, mt, mb, mu))):
+        raise ContactSolveError("non-finite load or friction coefficient", t=t)
+    Lr = 1.0 / geom.length_scale
+    return (np.array([ft, fb, ms, mt, mb]), np.array([1.0, 1.0, Lr, Lr, Lr]),
+            max(abs(ft), abs(fb), Lr * abs(ms), Lr * abs(mt), Lr * abs(mb)))
+
+
+def _start(geom: SliderGeometry, spring: SpringLaw, c5, x0) -> np.ndarray:
+    """The Newton start: x0 where it compresses a spring, else the cold start."""
+    if x0 is not None:
+        x = np.array(x0, dtype=float).reshape(5)
+        if (geom.A @ x).max() > 0.0:    # also catches NaN; no spring compressed: cold start
+            return x
+    return _cold_start(geom, spring, c5)
+
+
+def _compiled_newton(geom, spring, GT, kappa_GA, c5, S, x, tol, load_scale, max_iter, t):
+    """micro_motion_compiled.newton; (x, iterations, delta, f, f', R, load sensitivity z) or
+    ContactSolveError with the reason."""
+    x, status, it, err, delta, f, fp, R, z = _compiled.newton(
+        geom.A, GT, kappa_GA, c5, S, x, spring.k0, spring.eps, tol, load_scale, max_iter)
+    if status == 0:
+        return x, it, delta, f, fp, R, z
+    reason = {1: "singular Newton matrix",
+              2: f"line search failed (|S R| = {err:.3e}, tol {tol:.3e})",
+              3: f"no convergence in {max_iter} Newton iterations "
+                 f"(|S R| = {err:.3e}, tol {tol:.3e})"}[status]
+    raise ContactSolveError(reason, t=t, iterations=it, residual=R, last_x=x)
+
+
+def normal_load(geom: SliderGeometry, spring: SpringLaw, f_c, m_c, mu: float, GT, kappa_GA,
+                x0=None, *, rtol: float = 1e-11, max_iter: int = 50, t: float = float("nan")):
+    """(N = sum f_ij, dN/dc (5,), x) of the micro-motion solve: what the friction Newton needs
+    (Eq. 65's normal load and its sensitivity, ContactSolution.normal_load_gradient), without
+    building the ContactSolution; GT, kappa_GA from :func:`newton_matrices` at this mu.  The
+    same solve as :func:`solve_micro_motion` (compiled Newton; the Python loop where numba or
+    the plain SpringLaw is missing)."""
+    c5, S, load_scale = _load_vector(geom, f_c, m_c, mu, t)
+    if load_scale == 0.0:
+        return 0.0, np.zeros(5), np.zeros(5)
+    if not (_compiled.AVAILABLE and type(spring) is SpringLaw):
+        sol = solve_micro_motion(geom, spring, f_c, m_c, mu, x0, rtol=rtol, max_iter=max_iter,
+                                 t=t)
+        return sol.total_normal_force, sol.normal_load_gradient(), sol.x
+    x = _start(geom, spring, c5, x0)
+    x, _, _, f, _, _, z = _compiled_newton(geom, spring, GT, kappa_GA, c5, S, x,
+                                           rtol * load_scale, load_scale, max_iter, t)
+    return float(f.sum()), -z, x
+
+
 def solve_micro_motion(geom: SliderGeometry, spring: SpringLaw, f_c, m_c, mu_value: float = 0.0,
                        x0=None, *, rtol: float = 1e-11, max_iter: int = 50,
                        t: float = float("nan")) -> ContactSolution:
@@ -530,18 +593,11 @@ def solve_micro_motion(geom: SliderGeometry, spring: SpringLaw, f_c, m_c, mu_val
     if f_c.shape != (3,) or m_c.shape != (3,):
         raise ValueError(f"solve_micro_motion: f_c, m_c must have shape (3,), got "
                          f"{f_c.shape}, {m_c.shape}")
-    fs, ft, fb = f_c.tolist()
-    ms, mt, mb = m_c.tolist()
-    if not all(map(math.isfinite, (fs, ft, fb, ms, mt, mb, mu))):
-        raise ContactSolveError("non-finite load or friction coefficient", t=t)
-    # Eqs. 67-71 (paper Section 8.3), ordered like x: (f_t, f_b, m_s, m_t, m_b) equations
-    c5 = np.array([ft, fb, ms, mt, mb])
+    fs = float(f_c[0])
+    c5, S, load_scale = _load_vector(geom, f_c, m_c, mu, t)
     A = geom.A
     n = geom.n_springs
-    GT = geom.AT + mu * geom.BfT if mu != 0.0 else geom.AT   # R = c + G^T f(A x), G = A + mu Bf
-    Lr = 1.0 / geom.length_scale
-    S = np.array([1.0, 1.0, Lr, Lr, Lr])
-    load_scale = max(abs(ft), abs(fb), Lr * abs(ms), Lr * abs(mt), Lr * abs(mb))
+    GT, kappa_GA = newton_matrices(geom, spring, mu)
     fat = spring.force_and_tangent
 
     def finish(x, delta, f, fp, R, it, floor=None, sensitivity=None):
@@ -556,29 +612,14 @@ def solve_micro_motion(geom: SliderGeometry, spring: SpringLaw, f_c, m_c, mu_val
         z = np.zeros(n)
         return finish(np.zeros(5), z, z, z.copy(), np.zeros(5), 0)
 
-    x = None
-    if x0 is not None:
-        x = np.array(x0, dtype=float).reshape(5)
-        delta = A @ x
-        if not delta.max() > 0.0:       # also catches NaN; no spring compressed: cold start
-            x = None
-    if x is None:
-        x = _cold_start(geom, spring, c5)
-        delta = A @ x
-
-    kappa_GA = (_KAPPA * spring.k0) * (geom.AtA + mu * geom.BftA)
+    x = _start(geom, spring, c5, x0)
+    delta = A @ x
     tol = rtol * load_scale
     if _compiled.AVAILABLE and type(spring) is SpringLaw:
         # the same Newton as the loop below, compiled (micro_motion_compiled)
-        x, status, it, err, delta, f, fp, R, z = _compiled.newton(
-            A, GT, kappa_GA, c5, S, x, spring.k0, spring.eps, tol, load_scale, max_iter)
-        if status == 0:
-            return finish(x, delta, f, fp, R, it, kappa_GA, z)
-        reason = {1: "singular Newton matrix",
-                  2: f"line search failed (|S R| = {err:.3e}, tol {tol:.3e})",
-                  3: f"no convergence in {max_iter} Newton iterations "
-                     f"(|S R| = {err:.3e}, tol {tol:.3e})"}[status]
-        raise ContactSolveError(reason, t=t, iterations=it, residual=R, last_x=x)
+        x, it, delta, f, fp, R, z = _compiled_newton(geom, spring, GT, kappa_GA, c5, S, x, tol,
+                                                     load_scale, max_iter, t)
+        return finish(x, delta, f, fp, R, it, kappa_GA, z)
     f, fp = fat(delta)
     R = c5 + GT @ f
     SR = S * R

@@ -576,3 +576,26 @@ def test_compiled_newton_equals_the_python_loop(monkeypatch):
     with pytest.raises(ContactSolveError, match="no convergence in 0 Newton") as exc:
         solve_micro_motion(g, SPRING, f_c, m_c, 0.1, max_iter=0, t=2.5)
     assert exc.value.t == 2.5 and exc.value.residual is not None
+
+
+@pytest.mark.parametrize("compiled", [True, False])
+def test_normal_load_equals_the_full_solve(compiled, monkeypatch):
+    """normal_load (the friction Newton's lean path: no ContactSolution; the Newton matrices
+    formed once per mu) gives the full solve's normal load, its gradient and micro-motions,
+    cold and warm started, and zero at zero load."""
+    from sim_core.contact.sliding_block_contact import newton_matrices, normal_load
+    if compiled and not micro_motion_compiled.AVAILABLE:
+        pytest.skip("numba not installed")
+    monkeypatch.setattr(micro_motion_compiled, "AVAILABLE", compiled)
+    for g, f_c, m_c, mu in random_loads(13, 40):
+        mats = newton_matrices(g, SPRING, mu)
+        for x0 in (None, solve_micro_motion(g, SPRING, 0.9 * f_c, 1.1 * m_c, mu).x):
+            ref = solve_micro_motion(g, SPRING, f_c, m_c, mu, x0=x0)
+            N, dN, x = normal_load(g, SPRING, f_c, m_c, mu, *mats, x0=x0)
+            assert N == pytest.approx(ref.total_normal_force, rel=1e-12)
+            np.testing.assert_allclose(dN, ref.normal_load_gradient(), rtol=1e-10,
+                                       atol=1e-12 * np.abs(dN).max())
+            np.testing.assert_allclose(x, ref.x, rtol=0, atol=1e-12 * np.abs(ref.x).max())
+    N, dN, x = normal_load(g, SPRING, np.zeros(3), np.zeros(3), 0.1,
+                           *newton_matrices(g, SPRING, 0.1))
+    assert N == 0.0 and not dN.any()
