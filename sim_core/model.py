@@ -180,6 +180,17 @@ class Model:
             return element_compiled.element_mass_force(el, qe, qde, needs_mass=mass, **kw)
         return self.element_mass_force(self.element_context(t, el, qe, qde, kin), mass)
 
+    def element_residual(self, t: float, el, qe: np.ndarray, qde: np.ndarray,
+                         qdde: np.ndarray) -> np.ndarray:
+        """F_e - M_e qdde of one element; on the compiled path the product is formed through
+        the kernel's weighted rows without the mass matrix (the structured Jacobian differences
+        this column by column)."""
+        kw = self._compiled_effects(el.section) if element_compiled.AVAILABLE else None
+        if kw is not None and not (np.iscomplexobj(qe) or np.iscomplexobj(qde)):
+            return element_compiled.element_mass_force(el, qe, qde, qdde=qdde, **kw)[1]
+        Me, Fe = self.element_mass_force(self.element_context(t, el, qe, qde))
+        return Fe - Me @ qdde
+
     def element_terms_compiled(self, el) -> bool:
         """True where :meth:`element_terms` of this element takes the compiled kernel (for real
         states)."""

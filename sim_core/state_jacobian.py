@@ -90,8 +90,7 @@ def state_jacobian(model, t: float, y: np.ndarray, rel_step: float = REL_STEP,
         kin0 = None if model.element_terms_compiled(el) else model.element_kinematics(el, qe)
 
         def by_position(el=el, qe=qe, qde=qde, qdde=qdde):
-            Me, Fe = model.element_terms(t, el, qe, qde)
-            return Fe - Me @ qdde
+            return model.element_residual(t, el, qe, qde, qdde)
 
         def by_rate(el=el, qe=qe, qde=qde, kin=kin0):
             return model.element_terms(t, el, qe, qde, mass=False, kin=kin)[1]

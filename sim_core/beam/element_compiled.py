@@ -41,6 +41,7 @@ from . import cardan_compiled
 AVAILABLE = cardan_compiled.AVAILABLE
 
 _CSTEP = 1e-20      # complex-step size, as sim_core.model._CSTEP
+_NO_ACC = np.zeros(0)
 
 
 def _centre_line(qe, X, Y, n, basis):
@@ -219,8 +220,10 @@ def _convective(qe, qde, cstep, n, D_all, q_pos, q_sub, pow_p, pow_t, basis, i_s
 
 
 def _mass_force(qe, qde, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_sub, D_all, basis,
-                i_s1, rhoA, Jrot, D, h, grav, inertia, elasticity, gravity, needs_mass, cstep):
-    """(Me (nq, nq) or (0, 0), Fe (nq,)) of one element; see element_mass_force."""
+                i_s1, rhoA, Jrot, D, h, grav, inertia, elasticity, gravity, needs_mass, cstep,
+                qdde):
+    """(Me (nq, nq) or (0, 0), Fe (nq,)) of one element; see element_mass_force.  A non-empty
+    ``qdde`` subtracts Me qdde from Fe through the rows (Me = sum_rows w c J^T J)."""
     G = q_phi.shape[0]
     na = n + 4
     npos = 3 * na
@@ -345,6 +348,19 @@ def _mass_force(qe, qde, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_sub,
                 for k in range(nq):
                     edot += J[g, 6 + r, k] * qde[k]
                 v[g, 6 + r] -= wl[g] * D[r] * (0.5 * h * edot + (h * h / 6.0) * eddot_c[g, r])
+        if qdde.shape[0] > 0:           # - Me qdde = - sum_rows (w c) J^T (J qdde)
+            for i in range(K):
+                if i < 3:
+                    c = rhoA if inertia else 0.0
+                elif i < 6:
+                    c = Jrot[i - 3] if inertia else 0.0
+                else:
+                    c = (h * h / 6.0) * D[i - 6] if filt else 0.0
+                if c != 0.0:
+                    acc = 0.0
+                    for k in range(nq):
+                        acc += J[g, i, k] * qdde[k]
+                    v[g, i] -= wl[g] * c * acc
     J2 = J.reshape(G * K, nq)
     Fe = np.dot(v.reshape(G * K), J2)
     for k in range(nq):
@@ -438,7 +454,7 @@ if AVAILABLE:
 
 
 def element_mass_force(el, qe, qde, rhoA, Jrot, D, h=0.0, g=None, inertia=True,
-                       elasticity=True, needs_mass=True, cstep=_CSTEP):
+                       elasticity=True, needs_mass=True, cstep=_CSTEP, qdde=None):
     """Element mass matrix (or None) and force vector, M q_ddot = F, of spline element ``el``
     (a ``SplineElement``) at the real state (qe, qde), for the effects
 
@@ -450,6 +466,8 @@ def element_mass_force(el, qe, qde, rhoA, Jrot, D, h=0.0, g=None, inertia=True,
 
     i.e. the totals of ``Model.element_mass_force(Model.element_context(t, el, qe, qde))`` with
     those effects.  ``needs_mass=False`` returns (None, Fe) (the mass products are skipped).
+    ``qdde`` (nq,): returns (None, Fe - Me qdde), the product formed through the weighted rows
+    without the mass matrix (the structured Jacobian's element columns).
     Raises RuntimeError if numba is not installed (use the Model path then).
     """
     if not AVAILABLE:
@@ -459,12 +477,15 @@ def element_mass_force(el, qe, qde, rhoA, Jrot, D, h=0.0, g=None, inertia=True,
     qe = np.ascontiguousarray(qe, dtype=float)
     qde = np.ascontiguousarray(qde, dtype=float)
     grav = np.zeros(3) if g is None else np.ascontiguousarray(g, dtype=float)
+    if qdde is not None:
+        needs_mass = False
     Me, Fe = _compiled_mass_force(
         qe, qde, el.n, el._q_phi, el._q_psi, el._pow_p, el._pow_t, el._q_ds_dchi, el.q_w,
         el._q_pos, el.q_sub, el._D_all, el.G, el.i_s1, float(rhoA),
         np.ascontiguousarray(Jrot, dtype=float), np.ascontiguousarray(D, dtype=float),
         float(h), grav, bool(inertia), bool(elasticity), bool(np.any(grav != 0.0)),
-        bool(needs_mass), float(cstep))
+        bool(needs_mass), float(cstep),
+        _NO_ACC if qdde is None else np.ascontiguousarray(qdde, dtype=float))
     cardan_compiled.check_finite(Fe.sum() + (Me.sum() if needs_mass else 0.0),
                                  "element mass matrix or forces")
     return (Me if needs_mass else None), Fe

@@ -93,6 +93,20 @@ def test_equals_model_element_mass_force(n_nodes, which):
     M0, F0 = element_compiled.element_mass_force(el, qe, qde, needs_mass=False, **kw)
     assert M0 is None
     _check(F0, F_ref, "F (needs_mass=False)")
+    # F - M qdd through the weighted rows (qdde), as the structured Jacobian takes it, and
+    # Model.element_residual on both paths
+    qdde = np.random.default_rng(5).standard_normal(el.n_coords)
+    R_ref = F_ref - M_ref @ qdde
+    M1, R = element_compiled.element_mass_force(el, qe, qde, qdde=qdde, **kw)
+    assert M1 is None
+    _check(R, R_ref, "F - M qdd")
+    _check(model.element_residual(0.0, el, qe, qde, qdde), R_ref, "Model.element_residual")
+    element_compiled.AVAILABLE = False
+    try:
+        _check(model.element_residual(0.0, el, qe, qde, qdde), R_ref,
+               "Model.element_residual (reference path)")
+    finally:
+        element_compiled.AVAILABLE = True
 
 
 def test_explicit_arguments():
