@@ -9,13 +9,16 @@ constraint drift.  Constraint reactions are recovered as A^T lambda = M Q_ddot -
 
 from __future__ import annotations
 
+import os
+import threading
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import Callable, Sequence
 
 import numpy as np
 import scipy.linalg as sla
 
-from .beam import element_compiled
+from .beam import cardan_compiled, element_compiled
 from .assembly_compiled import scatter_add
 from .beam.moving_node_beam import Beam
 from .constraints import constraint_terms, kkt_accelerations, kkt_factor
@@ -66,6 +69,9 @@ class Model:
     # the saddle-point system by block elimination over the beams (constraints.kkt_factor)
     # where M_r is block-diagonal in them; False: the LU of the whole matrix (the reference)
     kkt_blocks: bool = True
+    # the element batch on a worker thread while the constraint rows are evaluated
+    # (_element_blocks_started); False: on the calling thread
+    element_thread: bool = True
 
     def __post_init__(self):
         self.offsets = np.cumsum([0] + [b.n_coords for b in self.beams])[:-1]
@@ -235,12 +241,13 @@ class Model:
             pe.add(t, Q, Qd, M, F)
         return M, F
 
-    def _scatter_local_terms(self, t, Q, Qd, M, F, red, sg, Qdd_p=None) -> list:
+    def _scatter_local_terms(self, t, Q, Qd, M, F, red, sg, Qdd_p=None, elements=None) -> list:
         """Add every element's, point load's and local point effect's (Me, Fe) into (M, F)
         through the coordinate map (red, sg) (:func:`assembly_compiled.scatter_add`); with
         ``Qdd_p`` the force is F - M Qdd_p.  Returns the point effects without a local form
         (``local(t, Q, Qd, mass) -> (idx, Me, Fe)``), for the caller to add on full arrays,
-        and whether a point effect's mass couples two beams (elements never do)."""
+        and whether a point effect's mass couples two beams (elements never do).  ``elements``:
+        the element batch if already started (:meth:`_element_blocks_started`)."""
         mass = M is not None
         coupled = False
 
@@ -249,8 +256,9 @@ class Model:
                 Fe = Fe - Me @ Qdd_p[idx]
             scatter_add(M, F, red, sg, idx, Me, Fe)
 
-        for el, idx in self.element_indices():
-            put(idx, *self.element_terms(t, el, Q[idx], Qd[idx], mass))
+        blocks = elements
+        if blocks is None and mass:
+            blocks = self._element_blocks_started(t, Q, Qd)
         for pl in self.point_loads:
             put(*self._point_load_terms(pl, t, Q))
         rest = []
@@ -264,7 +272,54 @@ class Model:
                 put(idx, Me, Fe)
             else:
                 rest.append(pe)
+        if blocks is not None:                 # the batch (started above, maybe on the worker)
+            Ms, Fs = blocks()
+            for (_, idx), Me, Fe in zip(self.element_indices(), Ms, Fs):
+                put(idx, Me, Fe)
+        else:
+            for el, idx in self.element_indices():
+                put(idx, *self.element_terms(t, el, Q[idx], Qd[idx], mass))
         return rest, coupled
+
+    def _element_blocks_started(self, t, Q, Qd):
+        """Start the mass matrices and forces of all elements as one compiled batch
+        (:class:`element_compiled.ElementBatch`) and return a function that waits for them:
+        (Me (E, nq, nq), Fe (E, nq)) in the order of :meth:`element_indices`.  The batch runs
+        without the GIL; with ``element_thread`` on a worker thread, so that the point effects
+        and the constraint rows (Python) are evaluated meanwhile on the calling thread.  None
+        where the batch does not cover the model (other effects, unequal elements, complex
+        states): the elements are then evaluated one by one."""
+        if not element_compiled.AVAILABLE or np.iscomplexobj(Q) or np.iscomplexobj(Qd):
+            return None
+        pairs = self.__dict__.get("_element_pairs")
+        if pairs is None:
+            pairs = self._element_pairs = list(self.element_indices())
+            self._element_idx = (np.stack([idx for _, idx in pairs])
+                                 if len({len(idx) for _, idx in pairs}) == 1 else None)
+        if self._element_idx is None:
+            return None
+        els = [el for el, _ in pairs]
+        key = tuple(id(e) for e in self.effects)
+        plan = self.__dict__.get("_element_batch")
+        if plan is None or plan[0] != key or (plan[1] is not None and not plan[1].valid(els)):
+            kws = [self._compiled_effects(el.section) for el in els]
+            plan = self._element_batch = (key, element_compiled.ElementBatch.plan(els, kws))
+        batch = plan[1]
+        if batch is None:
+            return None
+        kw = self._compiled_effects(els[0].section)           # h and g of this call
+        QE, QDE = Q[self._element_idx], Qd[self._element_idx]
+        if not self.element_thread:
+            out = batch(QE, QDE, kw["h"], kw["g"])
+            return lambda: _checked(out)
+        started = threading.Event()
+
+        def job():
+            started.set()
+            return batch(QE, QDE, kw["h"], kw["g"])
+        future = _element_worker().submit(job)
+        started.wait()                 # lets the worker take the GIL to enter the kernel
+        return lambda: _checked(future.result())
 
     def _beam_of(self) -> np.ndarray:
         """The beam of each coordinate (-1: an extra coordinate)."""
@@ -311,11 +366,14 @@ class Model:
         Q, Qd = self.full_state(t, z, zd)
         return self._reduced_mass_force_at(t, Q, Qd, self.A_pinv @ self._b(t, 2))
 
-    def _reduced_mass_force_at(self, t, Q, Qd, Qdd_p, blocks: bool = False):
+    def _reduced_mass_force_at(self, t, Q, Qd, Qdd_p, blocks: bool = False, elements=None):
         """(M_r, F_r) at the full state; ``blocks``: and the reduced coordinates of each beam
         where M_r is block-diagonal in them (no point effect's mass couples two beams), else
-        None (for ``constraints.kkt_factor``)."""
+        None (for ``constraints.kkt_factor``).  ``elements``: the element batch if already
+        started (:meth:`_element_blocks_started`)."""
         if self._sel is None:
+            if elements is not None:
+                elements()                      # not used on this path: wait for it
             M, F = self.mass_force(t, Q, Qd)
             out = self.P.T @ M @ self.P, self.P.T @ (F - M @ Qdd_p)
             return out + (None,) if blocks else out
@@ -334,7 +392,8 @@ class Model:
         Mr = np.zeros((n, n), dtype=dt)
         Fr = np.zeros(n, dtype=dt)
         rest, coupled = self._scatter_local_terms(t, Q, Qd, Mr, Fr, *red[:2],
-                                                  Qdd_p=Qdd_p if np.any(Qdd_p) else None)
+                                                  Qdd_p=Qdd_p if np.any(Qdd_p) else None,
+                                                  elements=elements)
         if rest:
             N = self.n_coords
             M, F = np.zeros((N, N), dtype=dt), np.zeros(N, dtype=dt)
@@ -363,10 +422,22 @@ class Model:
         """z_ddot and the multipliers of the nonlinear constraints (empty if there are none)."""
         Q, Qd = self.full_state(t, z, zd)
         Qdd_p = self.A_pinv @ self._b(t, 2)
-        Mr, Fr, blocks = self._reduced_mass_force_at(t, Q, Qd, Qdd_p, blocks=True)
         if not self.nonlinear:
+            Mr, Fr = self._reduced_mass_force_at(t, Q, Qd, Qdd_p)
             return sla.solve(Mr, Fr, assume_a="pos"), np.zeros(0)
-        phi, J, dphi, c_rhs = constraint_terms(self.nonlinear, t, Q, Qd)
+        # the element batch runs (on the worker thread) while the constraint rows are formed
+        elements = self._element_blocks_started(t, Q, Qd) if self._sel is not None else None
+        try:
+            phi, J, dphi, c_rhs = constraint_terms(self.nonlinear, t, Q, Qd)
+        except BaseException:
+            if elements is not None:            # do not leave the batch running
+                try:
+                    elements()
+                except Exception:  # noqa: BLE001 - the constraint rows' error is the one raised
+                    pass
+            raise
+        Mr, Fr, blocks = self._reduced_mass_force_at(t, Q, Qd, Qdd_p, blocks=True,
+                                                     elements=elements)
         xi1, xi2 = self.baumgarte
         c_rhs = c_rhs - J @ Qdd_p - 2.0 * xi1 * dphi - xi2 ** 2 * phi
         if not self.multiplier_forces:
@@ -502,6 +573,28 @@ class Model:
         idx = off + beam.index_map[e]
         kin = beam.elements[e].evaluate(Q[idx], s=np.array([s]), strains=True)
         return kin.r[0], kin, idx
+
+
+# -- the element worker ---------------------------------------------------------------------
+
+_WORKER: list = []          # [(pid, ThreadPoolExecutor)]
+
+
+def _element_worker() -> ThreadPoolExecutor:
+    """One worker thread per process for the element batches (a forked child gets its own: the
+    parent's thread does not exist there)."""
+    if not _WORKER or _WORKER[0][0] != os.getpid():
+        _WORKER[:] = [(os.getpid(), ThreadPoolExecutor(1, thread_name_prefix="sim_core-elements"))]
+    return _WORKER[0][1]
+
+
+def _checked(out):
+    """The element batch's result after numpy's finite check of the calling thread (np.errstate
+    is per thread: a non-finite block raises FloatingPointError where the caller's numpy
+    would)."""
+    Ms, Fs = out
+    cardan_compiled.check_finite(Fs.sum() + Ms.sum(), "element mass matrix or forces")
+    return Ms, Fs
 
 
 # -- boundary conditions ---------------------------------------------------------------------

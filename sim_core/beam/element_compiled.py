@@ -401,6 +401,24 @@ def _mass_force(qe, qde, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_sub,
     return _gram(A.reshape(G * km, nq)), Fe
 
 
+def _mass_force_batch(QE, QDE, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_sub, D_all,
+                      bases, i_s1, rhoAs, Jrots, Ds, h, grav, inertia, elasticity, gravity, cstep,
+                      no_acc):
+    """_mass_force of E elements with the same tables (rows of QE, QDE; per element the
+    reference basis, rhoA, Jrot, D): (Me (E, nq, nq), Fe (E, nq)) in one call."""
+    E, nq = QE.shape
+    Ms = np.empty((E, nq, nq))
+    Fs = np.empty((E, nq))
+    for e in range(E):
+        M, F = _compiled_mass_force(QE[e], QDE[e], n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w,
+                                    q_pos, q_sub, D_all, bases[e], i_s1, rhoAs[e], Jrots[e],
+                                    Ds[e], h, grav, inertia, elasticity, gravity, True, cstep,
+                                    no_acc)
+        Ms[e] = M
+        Fs[e] = F
+    return Ms, Fs
+
+
 def _gram_dot(A):
     """A^T A (numba's np.dot, BLAS gemm)."""
     return np.dot(A.T, A)
@@ -451,6 +469,7 @@ if AVAILABLE:
     _convective = _jit(_convective)
     _gram = _jit(_gram_syrk if _SYRK else _gram_dot)
     _compiled_mass_force = _jit(_mass_force)
+    _compiled_mass_force_batch = _jit(_mass_force_batch)
 
 
 def element_mass_force(el, qe, qde, rhoA, Jrot, D, h=0.0, g=None, inertia=True,
@@ -489,6 +508,63 @@ def element_mass_force(el, qe, qde, rhoA, Jrot, D, h=0.0, g=None, inertia=True,
     cardan_compiled.check_finite(Fe.sum() + (Me.sum() if needs_mass else 0.0),
                                  "element mass matrix or forces")
     return (Me if needs_mass else None), Fe
+
+
+_TABLES = ("_q_phi", "_q_psi", "_pow_p", "_pow_t", "_q_ds_dchi", "q_w", "_q_pos", "q_sub",
+           "_D_all")
+
+
+class ElementBatch:
+    """Mass matrices and forces of several elements in one compiled call (nogil: it can run on
+    a second thread while the caller evaluates the constraint rows, ``Model``).  Valid for
+    elements with equal basis tables (the same nodes and Gauss points) and the same effect set;
+    :meth:`plan` returns None otherwise.  ``kws``: per element the effect arguments of
+    :func:`element_mass_force` (``Model._compiled_effects``)."""
+
+    def __init__(self, elements, kws):
+        el0 = elements[0]
+        self.key = tuple(id(el.q_xi) for el in elements) + tuple(id(el.q_sub) for el in elements)
+        self.tables = tuple(getattr(el0, name) for name in _TABLES)
+        self.n, self.i_s1 = el0.n, el0.i_s1
+        self.bases = np.ascontiguousarray(np.stack([el.G for el in elements]), dtype=float)
+        self.rhoAs = np.array([float(kw["rhoA"]) for kw in kws])
+        self.Jrots = np.ascontiguousarray(np.stack([kw["Jrot"] for kw in kws]), dtype=float)
+        self.Ds = np.ascontiguousarray(np.stack([kw["D"] for kw in kws]), dtype=float)
+        self.inertia = bool(kws[0]["inertia"])
+        self.elasticity = bool(kws[0]["elasticity"])
+
+    @staticmethod
+    def plan(elements, kws) -> "ElementBatch | None":
+        if not AVAILABLE or not elements or any(kw is None for kw in kws):
+            return None
+        for el in elements:
+            if el._tables_key[0] is not el.q_xi or el._tables_key[1] is not el.q_sub:
+                el._basis_tables()
+        el0 = elements[0]
+        for el in elements[1:]:
+            if el.n != el0.n or el.i_s1 != el0.i_s1 or not all(
+                    np.array_equal(getattr(el, name), getattr(el0, name)) for name in _TABLES):
+                return None
+        flags = {(kw["inertia"], kw["elasticity"], kw["h"]) for kw in kws}
+        gs = {tuple(np.asarray(kw["g"], float)) for kw in kws}
+        if len(flags) != 1 or len(gs) != 1:
+            return None
+        return ElementBatch(elements, kws)
+
+    def valid(self, elements) -> bool:
+        """The elements' Gauss points are still those of the plan."""
+        return self.key == (tuple(id(el.q_xi) for el in elements)
+                            + tuple(id(el.q_sub) for el in elements))
+
+    def __call__(self, QE, QDE, h, g, cstep=_CSTEP):
+        """(Me (E, nq, nq), Fe (E, nq)) at the rows of QE, QDE (real, C-contiguous).  No
+        finite check here (it reads numpy's error state, which is per thread): the caller
+        checks with ``cardan_compiled.check_finite``."""
+        grav = np.ascontiguousarray(g, dtype=float)
+        return _compiled_mass_force_batch(
+            QE, QDE, self.n, *self.tables, self.bases, self.i_s1, self.rhoAs, self.Jrots,
+            self.Ds, float(h), grav, self.inertia, self.elasticity, bool(np.any(grav != 0.0)),
+            float(cstep), _NO_ACC)
 
 
 def effect_parameters(effects, section):

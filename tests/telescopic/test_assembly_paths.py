@@ -155,3 +155,73 @@ def test_payload_local_block_is_the_dense_formula(state):
     np.testing.assert_allclose(M, pm.mass * J.T @ J, rtol=0, atol=1e-12 * pm.mass)
     f_ref = J.T @ (pm.mass * (pm.gravity - a))
     np.testing.assert_allclose(F, f_ref, rtol=0, atol=1e-6 * np.max(np.abs(f_ref)))
+
+
+def test_element_batch_equals_the_elements_one_by_one(state):
+    """The compiled batch (element_compiled.ElementBatch, one call for all elements) gives each
+    element's kernel result (bitwise); on the worker thread or the calling thread the
+    right-hand side is the same."""
+    from sim_core.beam import element_compiled
+    if not element_compiled.AVAILABLE:
+        pytest.skip("numba not installed")
+    ts, z, zd = state
+    m = ts.model
+    Q, Qd = m.full_state(0.3, z, zd)
+    started = m._element_blocks_started(0.3, Q, Qd)
+    assert started is not None
+    Ms, Fs = started()
+    for (el, idx), Me, Fe in zip(m.element_indices(), Ms, Fs):
+        M1, F1 = m.element_terms(0.3, el, Q[idx], Qd[idx])
+        np.testing.assert_array_equal(Me, M1)
+        np.testing.assert_array_equal(Fe, F1)
+    y = np.concatenate([z, zd])
+    m.element_thread = True
+    a = m.rhs(0.3, y)
+    m.element_thread = False
+    try:
+        b = m.rhs(0.3, y)
+    finally:
+        m.element_thread = True
+    # equal to round-off (the micro-motion solves are warm-started from the previous call)
+    np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12 * np.max(np.abs(a)))
+
+
+def test_element_batch_non_finite_raises_in_the_callers_error_state(state):
+    """numpy's error state is per thread: the batch's finite check runs on the calling thread,
+    so a non-finite element raises FloatingPointError where the caller asked numpy to raise
+    (the integrator's right-hand side), as the one-by-one path does."""
+    from sim_core.beam import element_compiled
+    if not element_compiled.AVAILABLE:
+        pytest.skip("numba not installed")
+    ts, z, zd = state
+    m = ts.model
+    Q, Qd = m.full_state(0.3, z, zd)
+    bad = Q.copy()
+    bad[next(iter(m.element_indices()))[1][5]] = np.inf
+    with np.errstate(invalid="raise", over="raise"):
+        with pytest.raises(FloatingPointError):
+            m._element_blocks_started(0.3, bad, Qd)()
+
+
+def _rhs_in_child(conn, model, y):
+    conn.send(model.rhs(0.3, y))
+    conn.close()
+
+
+def test_element_worker_in_a_forked_process(state):
+    """A process forked after the parent used the worker thread gets a worker of its own (the
+    parent's thread does not exist in the child): its right-hand side completes and equals the
+    parent's."""
+    import multiprocessing as mp
+    ts, z, zd = state
+    m = ts.model
+    y = np.concatenate([z, zd])
+    parent = m.rhs(0.3, y)                   # the parent's worker exists now
+    ctx = mp.get_context("fork")
+    recv, send = ctx.Pipe(duplex=False)
+    proc = ctx.Process(target=_rhs_in_child, args=(send, m, y))
+    proc.start()
+    assert recv.poll(120), "the forked child's right-hand side did not complete"
+    child = recv.recv()
+    proc.join(30)
+    np.testing.assert_allclose(child, parent, rtol=1e-12, atol=1e-12 * np.max(np.abs(parent)))
