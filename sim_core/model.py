@@ -289,6 +289,49 @@ class Model:
         and the constraint rows (Python) are evaluated meanwhile on the calling thread.  None
         where the batch does not cover the model (other effects, unequal elements, complex
         states): the elements are then evaluated one by one."""
+        plan = self._element_batch_plan(Q, Qd)
+        if plan is None:
+            return None
+        batch, kw = plan
+        QE, QDE = Q[self._element_idx], Qd[self._element_idx]
+        return self._run(lambda: batch(QE, QDE, kw["h"], kw["g"]))
+
+    def _element_differences_started(self, Q, Qd, Qdd, steps):
+        """Start the structured Jacobian's element columns as one compiled batch
+        (:meth:`element_compiled.ElementBatch.differences`; on the worker thread with
+        ``element_thread``) and return a function that waits for them: per element
+        (d(F - M Qdd)/dq, dF/dq_dot), in the order of :meth:`element_indices`.  ``steps(x)``:
+        the forward-difference steps of a coordinate vector.  None where the batch does not
+        cover the model."""
+        plan = self._element_batch_plan(Q, Qd)
+        if plan is None:
+            return None
+        batch, kw = plan
+        ix = self._element_idx
+        QE, QDE, QDDE = Q[ix], Qd[ix], np.ascontiguousarray(Qdd[ix], dtype=float)
+        HQ = np.stack([steps(q) for q in QE])
+        HQD = np.stack([steps(q) for q in QDE])
+        return self._run(lambda: batch.differences(QE, QDE, QDDE, HQ, HQD, kw["h"], kw["g"]))
+
+    def _run(self, job):
+        """job() on the element worker thread with ``element_thread`` (a function that waits
+        for it and checks its result for non-finite values on the calling thread), else at
+        once."""
+        if not self.element_thread:
+            out = job()
+            return lambda: _checked(out)
+        started = threading.Event()
+
+        def run():
+            started.set()
+            return job()
+        future = _element_worker().submit(run)
+        started.wait()                 # lets the worker take the GIL to enter the kernel
+        return lambda: _checked(future.result())
+
+    def _element_batch_plan(self, Q, Qd):
+        """(ElementBatch, effect arguments of this call) or None where the batch does not cover
+        the model (other effects, unequal elements, complex states)."""
         if not element_compiled.AVAILABLE or np.iscomplexobj(Q) or np.iscomplexobj(Qd):
             return None
         pairs = self.__dict__.get("_element_pairs")
@@ -307,19 +350,7 @@ class Model:
         batch = plan[1]
         if batch is None:
             return None
-        kw = self._compiled_effects(els[0].section)           # h and g of this call
-        QE, QDE = Q[self._element_idx], Qd[self._element_idx]
-        if not self.element_thread:
-            out = batch(QE, QDE, kw["h"], kw["g"])
-            return lambda: _checked(out)
-        started = threading.Event()
-
-        def job():
-            started.set()
-            return batch(QE, QDE, kw["h"], kw["g"])
-        future = _element_worker().submit(job)
-        started.wait()                 # lets the worker take the GIL to enter the kernel
-        return lambda: _checked(future.result())
+        return batch, self._compiled_effects(els[0].section)    # h and g of this call
 
     def _beam_of(self) -> np.ndarray:
         """The beam of each coordinate (-1: an extra coordinate)."""
@@ -589,12 +620,12 @@ def _element_worker() -> ThreadPoolExecutor:
 
 
 def _checked(out):
-    """The element batch's result after numpy's finite check of the calling thread (np.errstate
-    is per thread: a non-finite block raises FloatingPointError where the caller's numpy
-    would)."""
-    Ms, Fs = out
-    cardan_compiled.check_finite(Fs.sum() + Ms.sum(), "element mass matrix or forces")
-    return Ms, Fs
+    """The element batch's result (a pair of arrays) after numpy's finite check of the calling
+    thread (np.errstate is per thread: a non-finite block raises FloatingPointError where the
+    caller's numpy would)."""
+    a, b = out
+    cardan_compiled.check_finite(a.sum() + b.sum(), "element mass matrix or forces")
+    return a, b
 
 
 # -- boundary conditions ---------------------------------------------------------------------

@@ -84,7 +84,11 @@ def state_jacobian(model, t: float, y: np.ndarray, rel_step: float = REL_STEP,
     # elements: F_e(q_e, qd_e) - M_e(q_e) qdd_e in the element's own coordinates; the rate
     # columns skip the mass matrix (M_e does not depend on rates), and on the numpy path reuse
     # the position-level kinematics
-    for el, idx in model.element_indices():
+    # the compiled batch of all elements' columns (on the worker thread, while the point pieces
+    # below are differenced on this one), else element by element here
+    batch = None if central else model._element_differences_started(
+        Q, Qd, Qdd, lambda x: _steps(x, rel_step))
+    for el, idx in ([] if batch is not None else model.element_indices()):
         qdde = Qdd[idx]
         qe, qde = Q[idx].copy(), Qd[idx].copy()
         kin0 = None if model.element_terms_compiled(el) else model.element_kinematics(el, qe)
@@ -186,6 +190,14 @@ def state_jacobian(model, t: float, y: np.ndarray, rel_step: float = REL_STEP,
                 dR1[:, col] += (u[0] - l[0]) * scale
                 if pieces[k][3] is not None:
                     dR2[pieces[k][3], col] += (u[1] - l[1]) * scale
+
+    if batch is not None:
+        DP, DR = batch()
+        for (_, idx), dp, dr in zip(model.element_indices(), DP, DR):
+            dR1[np.ix_(idx, idx)] += dp
+            dR1[np.ix_(idx, N + idx)] += dr
+            n_el += 1
+            el_evals += 2 * len(idx) + 1
 
     dF_dlam = np.zeros((N, m))
     for mf in model.multiplier_forces:

@@ -419,6 +419,38 @@ def _mass_force_batch(QE, QDE, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, 
     return Ms, Fs
 
 
+def _differences_batch(QE, QDE, QDDE, HQ, HQD, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos,
+                       q_sub, D_all, bases, i_s1, rhoAs, Jrots, Ds, h, grav, inertia,
+                       elasticity, gravity, cstep, no_acc):
+    """Forward differences of E elements (the structured Jacobian's element columns,
+    sim_core.state_jacobian): per element d(F - M qdd)/dq and dF/dq_dot (nq, nq), steps HQ,
+    HQD (exactly representable), the same kernel calls as the one-by-one path."""
+    E, nq = QE.shape
+    DP = np.empty((E, nq, nq))
+    DR = np.empty((E, nq, nq))
+    for e in range(E):
+        qe = QE[e].copy()
+        qde = QDE[e].copy()
+        args = (n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_sub, D_all, bases[e], i_s1,
+                rhoAs[e], Jrots[e], Ds[e], h, grav, inertia, elasticity, gravity, False, cstep)
+        R0 = _compiled_mass_force(qe, qde, *args, QDDE[e])[1]
+        F0 = _compiled_mass_force(qe, qde, *args, no_acc)[1]
+        for j in range(nq):
+            x = qe[j]
+            qe[j] = x + HQ[e, j]
+            R = _compiled_mass_force(qe, qde, *args, QDDE[e])[1]
+            qe[j] = x
+            for i in range(nq):
+                DP[e, i, j] = (R[i] - R0[i]) / HQ[e, j]
+            x = qde[j]
+            qde[j] = x + HQD[e, j]
+            F = _compiled_mass_force(qe, qde, *args, no_acc)[1]
+            qde[j] = x
+            for i in range(nq):
+                DR[e, i, j] = (F[i] - F0[i]) / HQD[e, j]
+    return DP, DR
+
+
 def _gram_dot(A):
     """A^T A (numba's np.dot, BLAS gemm)."""
     return np.dot(A.T, A)
@@ -470,6 +502,7 @@ if AVAILABLE:
     _gram = _jit(_gram_syrk if _SYRK else _gram_dot)
     _compiled_mass_force = _jit(_mass_force)
     _compiled_mass_force_batch = _jit(_mass_force_batch)
+    _compiled_differences_batch = _jit(_differences_batch)
 
 
 def element_mass_force(el, qe, qde, rhoA, Jrot, D, h=0.0, g=None, inertia=True,
@@ -565,6 +598,16 @@ class ElementBatch:
             QE, QDE, self.n, *self.tables, self.bases, self.i_s1, self.rhoAs, self.Jrots,
             self.Ds, float(h), grav, self.inertia, self.elasticity, bool(np.any(grav != 0.0)),
             float(cstep), _NO_ACC)
+
+    def differences(self, QE, QDE, QDDE, HQ, HQD, h, g, cstep=_CSTEP):
+        """(d(F - M qdd)/dq, dF/dq_dot) (E, nq, nq) of every element by forward differences
+        with the steps HQ, HQD (E, nq) at the rows of QE, QDE, QDDE (no finite check here,
+        as in __call__)."""
+        grav = np.ascontiguousarray(g, dtype=float)
+        return _compiled_differences_batch(
+            QE, QDE, QDDE, HQ, HQD, self.n, *self.tables, self.bases, self.i_s1, self.rhoAs,
+            self.Jrots, self.Ds, float(h), grav, self.inertia, self.elasticity,
+            bool(np.any(grav != 0.0)), float(cstep), _NO_ACC)
 
 
 def effect_parameters(effects, section):
