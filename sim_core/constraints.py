@@ -260,6 +260,17 @@ def material_point(model, ibeam: int, s_fixed: float | None = None, s_index: int
             sec = kin.sec
             angles, psi_prime, frame, tmat = (sec.angles[0], sec.psi_prime[0], sec.frame[0],
                                               sec.tmat[0])
+        if o_sec is not None:                             # frame: rows e_t, e_b, e_s (global)
+            o = o_sec[1] * frame[0] + o_sec[2] * frame[1] + o_sec[0] * frame[2]
+            # small global rotation per dQ; tmat gives section components ordered (s, t, b);
+            # on the element's columns (the s column below gets the same map through psi')
+            R = frame[[2, 0, 1]].T @ tmat
+            ox = np.array([[0.0, o[2], -o[1]], [-o[2], 0.0, o[0]], [o[1], -o[0], 0.0]],
+                          dtype=R.dtype)                  # J += (R dpsi) x o = ox R dpsi
+            oxR = ox @ R
+            J_r = J_r + oxR @ J_psi
+            rp = rp + oxR @ psi_prime
+            r = r + o
         J = np.zeros((3, N), dtype=J_r.dtype)
         Jp = np.zeros((3, N), dtype=J_r.dtype)
         J[:, idx] = J_r
@@ -267,14 +278,6 @@ def material_point(model, ibeam: int, s_fixed: float | None = None, s_index: int
         if s_index is not None:
             J[:, s_index] += rp
             Jp[:, s_index] += psi_prime
-        if o_sec is not None:                             # frame: rows e_t, e_b, e_s (global)
-            o = o_sec[1] * frame[0] + o_sec[2] * frame[1] + o_sec[0] * frame[2]
-            # small global rotation per dQ; tmat gives section components ordered (s, t, b)
-            rot = frame[[2, 0, 1]].T @ (tmat @ Jp)
-            J = J + np.stack([rot[1] * o[2] - rot[2] * o[1],      # delta_phi x o
-                              rot[2] * o[0] - rot[0] * o[2],
-                              rot[0] * o[1] - rot[1] * o[0]])
-            r = r + o
         return r, J, angles, Jp
 
     def locate(Q):

@@ -97,10 +97,12 @@ class RopeDrive:
         return k * self.slack_width * 0.5 * x * x
 
     def local(self, t, Q, Qd, mass=True):
-        """(idx, None, Fe) on the coordinates the rope's points depend on."""
-        idx = _cols(self.coords(Q), Q)
+        """(idx, None, Fe) on the coordinates where dl/dQ is not zero (those of the rope's
+        points)."""
         ell, grad = self.length(Q)
-        return idx, None, -self.tension(float(np.real(ell))) * np.real(grad[idx])
+        grad = np.real(grad)
+        idx = np.flatnonzero(grad)
+        return idx, None, -self.tension(float(np.real(ell))) * grad[idx]
 
     def add(self, t, Q, Qd, M, F):
         _add_local(self.local(t, Q, Qd, M is not None), M, F)

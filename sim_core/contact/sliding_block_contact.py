@@ -184,6 +184,13 @@ class FrictionLaw:
 
     def mu(self, v):
         """Signed friction coefficient mu(v) (scalar in, float out; array in, array out)."""
+        if isinstance(v, (float, int)):             # the same formula for one float
+            a = abs(v)
+            if a <= self.v_eps:
+                return self.mu_static * float(v) / self.v_eps
+            tau = min(a / self.v_eps - 1.0, 1.0)
+            return math.copysign(self.mu_static + (self.mu_dynamic - self.mu_static)
+                                 * tau * tau * (3.0 - 2.0 * tau), v)
         va = np.asarray(v, dtype=float)
         a = np.abs(va)
         tau = np.clip(a / self.v_eps - 1.0, 0.0, 1.0)

@@ -444,6 +444,8 @@ def test_friction_law_continuity():
     v = np.linspace(-0.05, 0.05, 1001)
     np.testing.assert_allclose(law.mu(v), -law.mu(-v), rtol=0, atol=0)
     assert np.all(np.abs(law.mu(v)) <= 0.15)
+    # the one-float path is the array formula
+    np.testing.assert_allclose([law.mu(float(x)) for x in v], law.mu(v), rtol=1e-15, atol=0)
     # dmu_dv vs central differences away from |v| = v_eps (where mu is only C0)
     vv = np.array([0.3, 0.7, 1.2, 1.5, 1.8, 2.5, -1.4, -0.2]) * v_eps
     hh = 1e-7 * v_eps

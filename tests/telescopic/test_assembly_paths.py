@@ -247,3 +247,25 @@ def test_jacobian_element_batch_equals_the_one_by_one_columns(state):
         del m._element_differences_started
     scale = np.max(np.abs(J_one), axis=0)
     np.testing.assert_allclose(J_batch, J_one, rtol=0, atol=1e-7 * np.max(scale))
+
+
+@pytest.mark.parametrize("moving", [False, True])
+def test_offset_point_jacobian_is_the_derivative(state, moving):
+    """A material point with a rigid offset (rope anchors, pivots; optionally at a moving
+    contact coordinate): dr/dQ v equals the complex-step derivative of r along random v, and
+    dPsi/dQ v that of Psi."""
+    ts, z, zd = state
+    m = ts.model
+    Q, _ = m.full_state(0.3, z, zd)
+    kw = dict(s_index=ts.s3_index[1]) if moving else dict(s_fixed=3.0)
+    p = material_point(m, 1, offset=(0.3, -0.1, 0.2), **kw)
+    r, J, psi, Jp = [np.array(x) for x in p(Q)]
+    rng = np.random.default_rng(4)
+    h = 1e-20
+    for _ in range(3):
+        v = rng.standard_normal(len(Q))
+        rc, _, psic, _ = p(Q + 1j * h * v)
+        np.testing.assert_allclose(J @ v, np.imag(rc) / h, rtol=1e-10,
+                                   atol=1e-12 * np.abs(J @ v).max())
+        np.testing.assert_allclose(Jp @ v, np.imag(psic) / h, rtol=1e-10,
+                                   atol=1e-12 * np.abs(Jp @ v).max())
