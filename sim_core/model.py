@@ -10,7 +10,6 @@ constraint drift.  Constraint reactions are recovered as A^T lambda = M Q_ddot -
 from __future__ import annotations
 
 import os
-import threading
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import Callable, Sequence
@@ -320,13 +319,9 @@ class Model:
         if not self.element_thread:
             out = job()
             return lambda: _checked(out)
-        started = threading.Event()
-
-        def run():
-            started.set()
-            return job()
-        future = _element_worker().submit(run)
-        started.wait()                 # lets the worker take the GIL to enter the kernel
+        # the worker takes the GIL to enter the kernel when this thread next releases it (the
+        # compiled point kernels of the constraint rows do, nogil)
+        future = _element_worker().submit(job)
         return lambda: _checked(future.result())
 
     def _element_batch_plan(self, Q, Qd):
