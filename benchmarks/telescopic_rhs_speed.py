@@ -23,7 +23,8 @@ last evaluation, and a benchmark that repeats one state measures cache hits.  Va
 * ``+ compiled elements``     and the element mass matrices and forces
   (``sim_core.beam.element_compiled``),
 * ``+ block saddle-point solve`` and the saddle-point system by block elimination over the
-  beams (``Model.kkt_blocks``; before: the LU of the whole matrix),
+  beams (``Model.kkt_blocks``, compiled: ``sim_core.saddle_point_compiled``; before: the LU of
+  the whole matrix),
 * ``+ compiled scatter``      and the element and point-effect blocks added into the reduced
   arrays by the compiled loop of ``sim_core.assembly_compiled`` (before: its numpy version),
 * ``+ elements on a worker thread`` and the compiled element batch on a second thread while

@@ -102,10 +102,13 @@ def kkt_factor(Mr: Vec, C: Vec, blocks=None):
     ``blocks``: index arrays of diagonal blocks of Mr that the caller guarantees uncoupled
     (Mr[b_i, b_j] = 0 for i != j; couplings to the coordinates outside every block are allowed),
     e.g. the beams of ``Model`` (``Model._reduced_mass_force_at``).  Then the system is solved
-    by block elimination (:func:`_kkt_factor_blocks`); where a block is not positive definite,
-    by the LU of the whole matrix (the reference)."""
+    by block elimination (:func:`_kkt_factor_blocks`, compiled in
+    :mod:`sim_core.saddle_point_compiled` where numba is installed); where a block is not
+    positive definite, by the LU of the whole matrix (the reference)."""
     if blocks is not None:
-        solve = _kkt_factor_blocks(Mr, C, blocks)
+        from . import saddle_point_compiled as compiled
+        solve = (compiled.kkt_factor_blocks(Mr, C, blocks) if compiled.AVAILABLE
+                 else _kkt_factor_blocks(Mr, C, blocks))
         if solve is not None:
             return solve
     import scipy.linalg as sla

@@ -3,8 +3,9 @@
 * reduced assembly (element and point-effect blocks scattered straight into P^T M P,
   ``sim_core.assembly_compiled``) against forming the full M and projecting it;
 * the compiled scatter against its numpy version;
-* the saddle-point solve by block elimination over the beams (``constraints._kkt_factor_blocks``)
-  against the LU of the whole matrix, with and without its refinement step;
+* the saddle-point solve by block elimination over the beams (``constraints._kkt_factor_blocks``
+  and its compiled version ``sim_core.saddle_point_compiled``) against the LU of the whole
+  matrix, with and without the refinement step;
 * the material point's real evaluation served from the real part of a complex-step one against
   a fresh real evaluation;
 * the payload's local block (``PointMass.local``) against M += m J^T J, F += m J^T (g - a).
@@ -13,7 +14,7 @@
 import numpy as np
 import pytest
 
-from sim_core import assembly_compiled
+from sim_core import assembly_compiled, saddle_point_compiled
 from sim_core.constraints import _kkt_factor_blocks, constraint_terms, kkt_factor, material_point
 from sim_core.point_effects import PointMass
 from sim_core.telescopic import TelescopicParams, build_telescopic, initial_equilibrium
@@ -104,6 +105,17 @@ def test_block_elimination_matches_the_whole_lu(state):
     # ~1e8 and more with the filter mass, enters the Schur complement): the step is needed
     unrefined = _kkt_factor_blocks(Mr, C, blocks, refine=False)
     assert _residual(K, Fr, c, unrefined(Fr, c)) >= r_blk
+    # the numpy elimination (the reference of the compiled one kkt_factor takes) and the
+    # compiled one agree, refined and not
+    ref = _kkt_factor_blocks(Mr, C, blocks)
+    assert _residual(K, Fr, c, ref(Fr, c)) <= 10.0 * r_lu + 1e-14
+    if saddle_point_compiled.AVAILABLE:
+        comp = saddle_point_compiled.kkt_factor_blocks(Mr, C, blocks)
+        for a, b in zip(comp(Fs, cs), ref(Fs, cs)):
+            np.testing.assert_allclose(a, b, rtol=0, atol=1e-11 * np.max(np.abs(b)))
+        raw = saddle_point_compiled.kkt_factor_blocks(Mr, C, blocks, refine=False)
+        for a, b in zip(raw(Fr, c), unrefined(Fr, c)):
+            np.testing.assert_allclose(a, b, rtol=0, atol=1e-6 * np.max(np.abs(b)))
 
 
 def test_block_elimination_falls_back_where_a_block_is_not_definite(state):
@@ -116,6 +128,8 @@ def test_block_elimination_falls_back_where_a_block_is_not_definite(state):
     b = blocks[0]
     Mr0[np.ix_(b, b)] *= -1.0
     assert _kkt_factor_blocks(Mr0, C, blocks) is None
+    if saddle_point_compiled.AVAILABLE:
+        assert saddle_point_compiled.kkt_factor_blocks(Mr0, C, blocks) is None
     sol = kkt_factor(Mr0, C, blocks)(Fr, c)
     ref = kkt_factor(Mr0, C)(Fr, c)
     assert np.all(np.isfinite(sol[0])) and np.all(np.isfinite(sol[1]))
