@@ -283,13 +283,19 @@ def material_point(model, ibeam: int, s_fixed: float | None = None, s_index: int
             Jp[:, s_index] += psi_prime
         return r, J, angles, Jp
 
+    # per element: its global indices, and the coordinates r and Psi depend on there (the
+    # element's, and s_index if moving)
+    where = [(off + imap, off + imap if s_index is None else np.append(off + imap, s_index))
+             for imap in beam.index_map]
+    for pair in where:                   # shared by every call: read-only
+        for a in pair:
+            a.flags.writeable = False
+
     def locate(Q):
-        """(element, its global indices, the coordinates r and Psi depend on at Q: the
-        element's, and s_index if moving)."""
-        s = np.real(Q[s_index]) if s_index is not None else s_fixed
+        """(element, its global indices, the coordinates r and Psi depend on at Q)."""
+        s = Q[s_index].real if s_index is not None else s_fixed
         e = model._element_at(ibeam, Q, float(s))
-        idx = off + beam.index_map[e]
-        return e, idx, (idx if s_index is None else np.append(idx, s_index))
+        return (e,) + where[e]
 
     def coords(Q):
         """The coordinates r and Psi depend on at Q: the element's, and s_index if moving."""

@@ -69,6 +69,10 @@ class _PiecewiseProfile:
     def sample(self, t: ArrayLike) -> MotionSample:
         """All four quantities at t (s): s = s0 + sign*s_unit, v/a/j = sign * unit values."""
         scalar = np.ndim(t) == 0
+        if scalar and hasattr(self, "_unit_scalar"):
+            s, v, a, j = self._unit_scalar(float(t) - self.t_start)
+            return MotionSample(float(self.s0 + self.sign * s), float(self.sign * v),
+                                float(self.sign * a), float(self.sign * j))
         tl = np.asarray(t, dtype=float) - self.t_start
         s, v, a, j = self._unit(tl)
         return MotionSample(_out(self.s0 + self.sign * s, scalar), _out(self.sign * v, scalar),
@@ -135,6 +139,18 @@ class CubicSmoothstepSchedule(_PiecewiseProfile):
         """Unsigned total stroke V * t_hold_end (SCENARIOS A4: 6 m), m."""
         return self.v_max * self.t_hold_end
 
+    def _ramps(self, tu, td):
+        """(s, v, a, j) of the ramp-up at tau = tu and of the ramp-down at tau = td (A4;
+        Zhao-Qi-Wang Sec. 9): up v = V(3tau^2 - 2tau^3), s = V T (tau^3 - tau^4/2); down
+        mirrored, v = V(1 - 3tau^2 + 2tau^3), s = sh + V T (tau - tau^3 + tau^4/2)."""
+        V, T = self.v_max, self.t_ramp
+        sh = 0.5 * V * T + V * (self.t_hold_end - T)
+        up = (V * T * (tu**3 - 0.5 * tu**4), V * (3 * tu**2 - 2 * tu**3),
+              6 * V / T * tu * (1 - tu), 6 * V / T**2 * (1 - 2 * tu))
+        down = (sh + V * T * (td - td**3 + 0.5 * td**4), V * (1 - 3 * td**2 + 2 * td**3),
+                -6 * V / T * td * (1 - td), -6 * V / T**2 * (1 - 2 * td))
+        return up, down
+
     def _unit(self, tl: np.ndarray) -> tuple[np.ndarray, ...]:
         V, T, th = self.v_max, self.t_ramp, self.t_hold_end
         s1 = 0.5 * V * T                      # stroke of one ramp, exact integral
@@ -142,17 +158,28 @@ class CubicSmoothstepSchedule(_PiecewiseProfile):
         tu = np.clip(tl / T, 0.0, 1.0)        # ramp-up tau
         td = np.clip((tl - th) / T, 0.0, 1.0)  # ramp-down tau
         up, hold, down = (tl >= 0) & (tl < T), (tl >= T) & (tl < th), (tl >= th) & (tl < th + T)
-        # Ramp-up (A4; Zhao-Qi-Wang Sec. 9): v = V(3tau^2 - 2tau^3), s = V T (tau^3 - tau^4/2).
-        # Ramp-down mirrored: v = V(1 - 3tau^2 + 2tau^3), s = sh + V T (tau - tau^3 + tau^4/2).
-        s = np.select([tl < 0, up, hold, down],
-                      [0.0, V * T * (tu**3 - 0.5 * tu**4), s1 + V * (tl - T),
-                       sh + V * T * (td - td**3 + 0.5 * td**4)], default=sh + s1)
-        v = np.select([up, hold, down], [V * (3 * tu**2 - 2 * tu**3), V,
-                                         V * (1 - 3 * td**2 + 2 * td**3)], default=0.0)
-        a = np.select([up, down], [6 * V / T * tu * (1 - tu), -6 * V / T * td * (1 - td)], 0.0)
-        j = np.select([up, down], [6 * V / T**2 * (1 - 2 * tu), -6 * V / T**2 * (1 - 2 * td)],
-                      0.0)
+        U, D = self._ramps(tu, td)
+        s = np.select([tl < 0, up, hold, down], [0.0, U[0], s1 + V * (tl - T), D[0]],
+                      default=sh + s1)
+        v = np.select([up, hold, down], [U[1], V, D[1]], default=0.0)
+        a = np.select([up, down], [U[2], D[2]], 0.0)
+        j = np.select([up, down], [U[3], D[3]], 0.0)
         return s, v, a, j
+
+    def _unit_scalar(self, tl: float) -> tuple[float, ...]:
+        """_unit at one time (the piece that holds it; the same formulas, without the array
+        selects: the telescopic drive samples one time per right-hand side)."""
+        V, T, th = self.v_max, self.t_ramp, self.t_hold_end
+        s1 = 0.5 * V * T
+        if tl < 0.0:
+            return 0.0, 0.0, 0.0, 0.0
+        if tl < T:
+            return self._ramps(min(tl / T, 1.0), 0.0)[0]
+        if tl < th:
+            return s1 + V * (tl - T), V, 0.0, 0.0
+        if tl < th + T:
+            return self._ramps(0.0, min((tl - th) / T, 1.0))[1]
+        return s1 + V * (th - T) + s1, 0.0, 0.0, 0.0
 
 
 @dataclass(frozen=True)

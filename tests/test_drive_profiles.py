@@ -138,3 +138,18 @@ def test_validation_errors_name_parameter(cls, kwargs, name):
         cls(**kwargs)
     msg = str(exc.value)
     assert msg.startswith(f"{name} = {kwargs[name]!r}") and "allowed range" in msg
+
+
+def test_cubic_one_time_equals_the_array_evaluation():
+    """sample(t) at one time (the scalar path the telescopic drive takes per right-hand side)
+    gives the array evaluation's values, on every piece and at the joints."""
+    sched = CubicSmoothstepSchedule(v_max=0.5, t_ramp=4.0, t_hold_end=12.0, sign=-1, s0=2.0,
+                                    t_start=0.3)
+    t = np.concatenate([np.linspace(-1.0, 18.0, 1901),
+                        0.3 + np.array([0.0, 4.0, 12.0, 16.0])])
+    arr = sched.sample(t)
+    for k, tk in enumerate(t):
+        one = sched.sample(float(tk))
+        for a, b in zip(one, arr):
+            assert isinstance(a, float)
+            assert a == pytest.approx(float(b[k]), rel=1e-14, abs=1e-14)
