@@ -45,32 +45,35 @@ def _i32(v):
     return a
 
 
-def _chol(A):
-    """In place: Cholesky factor of the symmetric A (C order; LAPACK's 'L' of the same
-    buffer); returns info."""
-    n = A.shape[0]
+def _chol(A, n):
+    """In place: Cholesky factor of the symmetric leading n x n block of the C-ordered square
+    A (LAPACK's 'L' of the same buffer, leading dimension A.shape[0]); returns info."""
     uplo = np.array([ord("L")], dtype=np.uint8)
     nn = _i32(n)
+    lda = _i32(A.shape[0])
     info = _i32(0)
-    _dpotrf(uplo.ctypes, nn.ctypes, A.ctypes, nn.ctypes, info.ctypes)
+    _dpotrf(uplo.ctypes, nn.ctypes, A.ctypes, lda.ctypes, info.ctypes)
     return info[0]
 
 
-def _chol_solve(Af, X):
-    """In place: X (nrhs, n) C order = the Fortran (n, nrhs) right-hand sides, solved with the
-    factor of _chol."""
-    nrhs, n = X.shape
+def _chol_solve(Af, n, X):
+    """In place: the first n columns of X (nrhs, ldx) C order = the Fortran (ldx, nrhs)
+    right-hand sides, solved with the factor of _chol (leading dimension Af.shape[0])."""
+    nrhs = X.shape[0]
     uplo = np.array([ord("L")], dtype=np.uint8)
     nn = _i32(n)
     nr = _i32(nrhs)
+    lda = _i32(Af.shape[0])
+    ldx = _i32(X.shape[1])
     info = _i32(0)
     if nrhs > 0:
-        _dpotrs(uplo.ctypes, nn.ctypes, nr.ctypes, Af.ctypes, nn.ctypes, X.ctypes, nn.ctypes,
+        _dpotrs(uplo.ctypes, nn.ctypes, nr.ctypes, Af.ctypes, lda.ctypes, X.ctypes, ldx.ctypes,
                 info.ctypes)
 
 
 def _factor(Mr, C, blocks, lens, r):
-    """(ok, factors (k, L, L), B (k, L, nb), Y (k, L, nb), S's LU (nb, nb) Fortran, pivots)."""
+    """(ok, factors (k, L, L), B (k, L, nb), Y (k, L, nb), S's LU (nb, nb) Fortran, pivots,
+    C^T); blocks padded to L (zero rows beyond a block's length)."""
     k, L = blocks.shape
     nr = r.shape[0]
     m = C.shape[0]
@@ -79,6 +82,7 @@ def _factor(Mr, C, blocks, lens, r):
     Bs = np.zeros((k, L, nb))
     Ys = np.zeros((k, L, nb))
     S = np.zeros((nb, nb))
+    CT = C.T.copy()
     for i in range(nr):
         for j in range(nr):
             S[i, j] = Mr[r[i], r[j]]
@@ -87,13 +91,13 @@ def _factor(Mr, C, blocks, lens, r):
             S[nr + j, i] = C[j, r[i]]
     for q in range(k):
         nq = lens[q]
-        A = np.empty((nq, nq))
+        A = facs[q]
         for i in range(nq):
             for j in range(nq):
                 A[i, j] = Mr[blocks[q, i], blocks[q, j]]
-        if _chol(A) != 0:
-            return False, facs, Bs, Ys, S, np.zeros(nb, dtype=np.int32)
-        Yt = np.empty((nb, nq))                  # Y^T in C order: the Fortran (nq, nb) block
+        if _chol(A, nq) != 0:
+            return False, facs, Bs, Ys, S, np.zeros(nb, dtype=np.int32), CT
+        Yt = np.zeros((nb, L))                   # Y^T in C order: the Fortran (L, nb) block
         for i in range(nq):
             bi = blocks[q, i]
             for j in range(nr):
@@ -103,25 +107,23 @@ def _factor(Mr, C, blocks, lens, r):
         for j in range(nb):
             for i in range(nq):
                 Yt[j, i] = Bs[q, i, j]
-        _chol_solve(A, Yt)
+        _chol_solve(A, nq, Yt)
         for i in range(nq):
-            for j in range(nq):
-                facs[q, i, j] = A[i, j]
             for j in range(nb):
                 Ys[q, i, j] = Yt[j, i]
-        S -= np.dot(Bs[q, :nq].T.copy(), Ys[q, :nq].copy())
+        S -= np.dot(Bs[q].T.copy(), Ys[q])       # zero rows beyond nq add nothing
     St = S.T.copy()                              # C order of S^T = Fortran order of S
     piv = np.zeros(nb, dtype=np.int32)
     nn = _i32(nb)
     info = _i32(0)
     _dgetrf(nn.ctypes, nn.ctypes, St.ctypes, nn.ctypes, piv.ctypes, info.ctypes)
-    return info[0] == 0, facs, Bs, Ys, St, piv
+    return info[0] == 0, facs, Bs, Ys, St, piv, CT
 
 
 def _once(facs, Bs, Ys, St, piv, blocks, lens, r, F, c):
     """One elimination solve: (z (n, nrhs), mu (m, nrhs)) of [[Mr, C^T], [C, 0]] [z; mu] =
     [F; c]."""
-    k = blocks.shape[0]
+    k, L = blocks.shape
     n, nrhs = F.shape
     nr = r.shape[0]
     m = c.shape[0]
@@ -132,16 +134,15 @@ def _once(facs, Bs, Ys, St, piv, blocks, lens, r, F, c):
             gt[j, i] = F[r[i], j]
         for i in range(m):
             gt[j, nr + i] = c[i, j]
-    us = []
+    us = np.zeros((k, nrhs, L))
     for q in range(k):
         nq = lens[q]
-        ut = np.empty((nrhs, nq))
+        ut = us[q]
         for j in range(nrhs):
             for i in range(nq):
                 ut[j, i] = F[blocks[q, i], j]
-        _chol_solve(facs[q, :nq, :nq].copy(), ut)
-        gt -= np.dot(ut, Bs[q, :nq].copy())      # (B^T u)^T = u^T B
-        us.append(ut)
+        _chol_solve(facs[q], nq, ut)
+        gt -= np.dot(ut, Bs[q])                  # (B^T u)^T = u^T B; zero padding
     trans = np.array([ord("N")], dtype=np.uint8)
     nn = _i32(nb)
     nr_ = _i32(nrhs)
@@ -152,9 +153,10 @@ def _once(facs, Bs, Ys, St, piv, blocks, lens, r, F, c):
     for j in range(nrhs):
         for i in range(nr):
             z[r[i], j] = gt[j, i]
+    w = gt.T.copy()
     for q in range(k):
         nq = lens[q]
-        Yw = np.dot(Ys[q, :nq].copy(), gt.T.copy())  # (nq, nrhs)
+        Yw = np.dot(Ys[q], w)                    # (L, nrhs)
         ut = us[q]
         for i in range(nq):
             for j in range(nrhs):
@@ -166,10 +168,10 @@ def _once(facs, Bs, Ys, St, piv, blocks, lens, r, F, c):
     return z, mu
 
 
-def _solve(Mr, C, facs, Bs, Ys, St, piv, blocks, lens, r, F, c, refine):
+def _solve(Mr, C, CT, facs, Bs, Ys, St, piv, blocks, lens, r, F, c, refine):
     z, mu = _once(facs, Bs, Ys, St, piv, blocks, lens, r, F, c)
     if refine:
-        rF = F - np.dot(Mr, z) - np.dot(C.T.copy(), mu)
+        rF = F - np.dot(Mr, z) - np.dot(CT, mu)
         rc = c - np.dot(C, z)
         dz, dmu = _once(facs, Bs, Ys, St, piv, blocks, lens, r, rF, rc)
         z = z + dz
@@ -203,7 +205,7 @@ def kkt_factor_blocks(Mr, C, blocks, refine: bool = True):
     r = np.flatnonzero(mask).astype(np.int64)
     Mr = np.ascontiguousarray(Mr, dtype=float)
     C = np.ascontiguousarray(C, dtype=float)
-    ok, facs, Bs, Ys, St, piv = _factor_compiled(Mr, C, B, lens, r)
+    ok, facs, Bs, Ys, St, piv, CT = _factor_compiled(Mr, C, B, lens, r)
     if not ok:
         return None
 
@@ -213,6 +215,6 @@ def kkt_factor_blocks(Mr, C, blocks, refine: bool = True):
         vec = F.ndim == 1
         F2 = np.ascontiguousarray(F.reshape(n, -1))
         c2 = np.ascontiguousarray(c.reshape(m, -1))
-        z, mu = _solve_compiled(Mr, C, facs, Bs, Ys, St, piv, B, lens, r, F2, c2, refine)
+        z, mu = _solve_compiled(Mr, C, CT, facs, Bs, Ys, St, piv, B, lens, r, F2, c2, refine)
         return (z[:, 0], -mu[:, 0]) if vec else (z, -mu)
     return solve
