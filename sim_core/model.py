@@ -122,6 +122,14 @@ class Model:
         X[rows] += sgn * x
         return X
 
+    def _times_P(self, J: np.ndarray) -> np.ndarray:
+        """J P (rows of coordinate derivatives -> reduced coordinates); a signed column
+        selection where P only selects coordinates."""
+        if self._sel is None:
+            return J @ self.P
+        rows, sgn, _ = self._sel
+        return J[:, rows] * sgn
+
     def reduced_state(self, t: float, Q: np.ndarray, Qd: np.ndarray):
         """Project a full state onto the constraint manifold's coordinates (z, z_dot)."""
         z = self.P.T @ (Q - self.A_pinv @ self._b(t, 0))
@@ -467,8 +475,8 @@ class Model:
         xi1, xi2 = self.baumgarte
         c_rhs = c_rhs - J @ Qdd_p - 2.0 * xi1 * dphi - xi2 ** 2 * phi
         if not self.multiplier_forces:
-            return kkt_accelerations(Mr, Fr, J @ self.P, c_rhs)
-        solve = kkt_factor(Mr, J @ self.P, blocks if self.kkt_blocks else None)
+            return kkt_accelerations(Mr, Fr, self._times_P(J), c_rhs)
+        solve = kkt_factor(Mr, self._times_P(J), blocks if self.kkt_blocks else None)
         if self.multiplier_newton and all(hasattr(mf, "at_state") for mf in self.multiplier_forces):
             return self._multiplier_newton(t, Q, Qd, solve, Fr, c_rhs)
         zdd, lam = solve(Fr, c_rhs)

@@ -209,23 +209,28 @@ def state_jacobian(model, t: float, y: np.ndarray, rel_step: float = REL_STEP,
         dF_dlam += _difference(lambda mf=mf: mf.forces(t, Q, Qd, lx), lx, np.arange(m),
                                rel_step, central)
 
-    # reduced coordinates and the saddle-point solve
-    P = model.P
+    # reduced coordinates and the saddle-point solve (X P and P^T X by Model._times_P: a signed
+    # selection where P only selects coordinates)
+    XP = model._times_P
+
+    def PtXP(X):
+        return XP(XP(X).T).T
+
     Mr, _ = model.reduced_mass_force(t, z, zd)
     if m:
         G = constraint_terms(model.nonlinear, t, Q, Qd)[1]
-        C = G @ P
+        C = XP(G)
     else:
         C = np.zeros((0, n))
     A = np.zeros((n + m, n + m))
     A[:n, :n] = -Mr
-    A[:n, n:] = C.T + P.T @ dF_dlam
+    A[:n, n:] = C.T + XP(dF_dlam.T).T
     A[n:, :n] = C
     B = np.empty((n + m, 2 * n))
-    B[:n, :n] = P.T @ dR1[:, :N] @ P
-    B[:n, n:] = P.T @ dR1[:, N:] @ P
-    B[n:, :n] = dR2[:, :N] @ P
-    B[n:, n:] = dR2[:, N:] @ P
+    B[:n, :n] = PtXP(dR1[:, :N])
+    B[:n, n:] = PtXP(dR1[:, N:])
+    B[n:, :n] = XP(dR2[:, :N])
+    B[n:, n:] = XP(dR2[:, N:])
     dU = -sla.solve(A, B)
     jac = np.zeros((2 * n, 2 * n))
     jac[:n, n:] = np.eye(n)

@@ -79,7 +79,7 @@ def static_parts(model: Model, t: float = 0.0):
         Q, _ = model.full_state(t, zz, np.zeros_like(zz))
         _, F = model.mass_force(t, Q, np.zeros_like(Q), mass=False)
         phi, J, _, _ = constraint_terms(model.nonlinear, t, Q, np.zeros_like(Q))
-        return model.P.T @ F, phi, J @ model.P
+        return model.P.T @ F, phi, model._times_P(J)
     return parts
 
 
