@@ -99,7 +99,51 @@ class ContactFriction:
             rp, ra = rows[name + "_point"], rows[name + "_angles"]
             Lf, Lm = section_reaction_maps(point, Q, self.basis, ra.stop - ra.start)
             regions.append((name, s_idx, rp, ra, Lf, Lm, self.law.mu(float(Qd[s_idx])), geom))
-        return FrictionAtState(self, regions, t)
+        return FrictionAtState(self, regions, t, batch=only is None)
+
+    def _compiled_regions(self, regions):
+        """values(lam, x0, gradient) -> (g, dg or None) of all ``regions`` in one compiled call
+        (micro_motion_compiled.regions_values), or None where it does not apply (regions
+        without slider geometry, another spring law, no numba, unequal spring counts).  The
+        call returns None where a region needs the reference path (a cold start, a failed
+        solve: FrictionAtState.values then re-solves region by region and raises the typed
+        error)."""
+        from .contact import micro_motion_compiled as mmc
+        from .contact.sliding_block_contact import _KAPPA
+        if not mmc.AVAILABLE or type(self.spring) is not SpringLaw or not regions:
+            return None
+        geoms = [r[7] for r in regions]
+        if any(gm is None for gm in geoms) or len({gm.n_springs for gm in geoms}) != 1:
+            return None
+        key = tuple(id(gm) for gm in geoms)
+        stack = self.__dict__.get("_geometry_stack")
+        if stack is None or stack[0] != key:
+            arrays = tuple(np.ascontiguousarray(np.stack([getattr(gm, a) for gm in geoms]),
+                                                dtype=float)
+                           for a in ("A", "AT", "BfT", "AtA", "BftA"))
+            Lr = np.array([1.0 / gm.length_scale for gm in geoms])
+            stack = self._geometry_stack = (key, arrays, Lr)
+        _, (A, AT, BfT, AtA, BftA), Lr = stack
+        names = [r[0] for r in regions]
+        Lf = np.ascontiguousarray(np.stack([r[4] for r in regions]), dtype=float)
+        Lm = np.ascontiguousarray(np.stack([r[5] for r in regions]), dtype=float)
+        rp = np.stack([np.arange(r[2].start, r[2].stop) for r in regions])
+        ra = np.stack([np.arange(r[3].start, r[3].stop) for r in regions])
+        mu = np.array([r[6] for r in regions], dtype=float)
+        k0, eps, kappa = self.spring.k0, self.spring.eps, _KAPPA * self.spring.k0
+        nan5 = np.full(5, np.nan)
+
+        def values(lam, x0, gradient):
+            X0 = np.stack([x0.get(nm, nan5) for nm in names]).astype(float)
+            g, dg, X, status = mmc.regions_values(lam, Lf, Lm, rp, ra, mu, A, AT, BfT, AtA,
+                                                   BftA, Lr, X0, k0, eps, kappa, 1e-11, 50,
+                                                   gradient)
+            if status.any():
+                return None
+            for nm, x in zip(names, X):
+                x0[nm] = x
+            return g, (dg if gradient else None)
+        return values
 
     def solve_regions(self, Q, Qd, lam):
         """Per region: (name, s_index, mu, ContactSolution) (distribution on) or
@@ -146,15 +190,25 @@ class FrictionAtState:
     regularised law), that :meth:`sim_core.model.Model.accelerations_and_multipliers` solves
     by Newton in the k values g."""
 
-    def __init__(self, owner: ContactFriction, regions: list, t: float = float("nan")):
+    def __init__(self, owner: ContactFriction, regions: list, t: float = float("nan"),
+                 batch: bool = True):
         self.owner = owner
         self.regions = regions
         self.t = t
         self.coords = np.array([r[1] for r in regions], dtype=int)
-        # the micro-motion Newton's matrices depend on the region and mu(s_dot) only: formed
-        # once per state, not in every friction iteration
-        self._matrices = [None if geom is None else newton_matrices(geom, owner.spring, mu)
-                          for (_, _, _, _, _, _, mu, geom) in regions]
+        self._mats = None
+        # all regions in one compiled call (the friction Newton's several evaluations at one
+        # state); a single region (a Jacobian column) takes the per-region path
+        self._batch = owner._compiled_regions(regions) if batch else None
+
+    @property
+    def _matrices(self):
+        """The micro-motion Newton's matrices per region: they depend on the region and
+        mu(s_dot) only, so they are formed once per state, not in every friction iteration."""
+        if self._mats is None:
+            self._mats = [None if geom is None else newton_matrices(geom, self.owner.spring, mu)
+                          for (_, _, _, _, _, _, mu, geom) in self.regions]
+        return self._mats
 
     def solve_regions(self, lam):
         out = []
@@ -173,9 +227,13 @@ class FrictionAtState:
     def values(self, lam, gradient: bool = False):
         """(g (k,), dg/dlambda (k, m) or None): g_r = -mu_r N_r, N the region's slider-spring
         sum (micro-motion solve, Eqs. 59-71) or its transverse resultant |(f_t, f_b)|."""
+        x0 = self.owner._x0
+        if self._batch is not None:            # all regions in one compiled call
+            out = self._batch(np.ascontiguousarray(lam, dtype=float), x0, gradient)
+            if out is not None:
+                return out
         g = np.empty(len(self.regions))
         dg = np.zeros((len(self.regions), len(lam))) if gradient else None
-        x0 = self.owner._x0
         spring = self.owner.spring
         for r, ((name, _, rp, ra, Lf, Lm, mu, geom), mats) in enumerate(
                 zip(self.regions, self._matrices)):

@@ -142,9 +142,67 @@ def _newton(A, GT, kappa_GA, c5, S, x, k0, eps, tol, load_scale, max_iter):
         it += 1
 
 
+def _regions_values(lam, Lf, Lm, rp, ra, mu, A, AT, BfT, AtA, BftA, Lr, X0, k0, eps, kappa,
+                    rtol, max_iter, gradient):
+    """The friction Newton's values of R contact regions in one call (contact_friction.
+    FrictionAtState.values; Zhao-Qi-Wang 2024 Eqs. 59-71 and 65): per region the section load
+    c = (f_t, f_b, m_s, m_t, m_b) from the multipliers (f = Lf lam[rp], m = Lm lam[ra]), the
+    micro-motion Newton of :func:`newton` from X0[q] and g_q = -mu_q N_q, N_q = sum f_ij, with
+    dg_q/dlam from the load sensitivity z (dN/dc = -z).  Returns (g (R,), dg (R, m), X (R, 5),
+    status (R,)): status 0 solved; 1-3 the Newton's failures; 4 X0[q] compresses no spring (a
+    cold start is needed); 5 a non-finite load.  The caller re-solves regions with status != 0
+    on the reference path (which cold-starts or raises the typed error)."""
+    R = mu.shape[0]
+    m = lam.shape[0]
+    na = Lm.shape[2]
+    g = np.zeros(R)
+    dg = np.zeros((R, m))
+    X = np.zeros((R, 5))
+    status = np.zeros(R, dtype=np.int64)
+    for q in range(R):
+        f_c = np.zeros(3)
+        m_c = np.zeros(3)
+        for i in range(3):
+            for j in range(3):
+                f_c[i] += Lf[q, i, j] * lam[rp[q, j]]
+            for j in range(na):
+                m_c[i] += Lm[q, i, j] * lam[ra[q, j]]
+        c5 = np.array([f_c[1], f_c[2], m_c[0], m_c[1], m_c[2]])
+        if not (np.all(np.isfinite(c5)) and np.isfinite(f_c[0]) and np.isfinite(mu[q])):
+            status[q] = 5
+            continue
+        Lrq = Lr[q]
+        S = np.array([1.0, 1.0, Lrq, Lrq, Lrq])
+        load_scale = max(abs(c5[0]), abs(c5[1]), Lrq * abs(c5[2]), Lrq * abs(c5[3]),
+                         Lrq * abs(c5[4]))
+        if load_scale == 0.0:
+            continue                    # no load: N = 0, g = 0, dg = 0, the rest position
+        GT = AT[q] + mu[q] * BfT[q]
+        kap = kappa * (AtA[q] + mu[q] * BftA[q])
+        x = X0[q].copy()
+        if not (np.all(np.isfinite(x)) and (A[q] @ x).max() > 0.0):
+            status[q] = 4
+            continue
+        x, st, it, err, delta, f, fp, Rr, z = newton(A[q], GT, kap, c5, S, x, k0, eps,
+                                                      rtol * load_scale, load_scale, max_iter)
+        if st != 0:
+            status[q] = st
+            continue
+        X[q] = x
+        g[q] = -mu[q] * f.sum()
+        if gradient and mu[q] != 0.0:   # dN/dc = -z
+            for j in range(3):
+                dg[q, rp[q, j]] = mu[q] * (z[0] * Lf[q, 1, j] + z[1] * Lf[q, 2, j])
+            for j in range(na):
+                dg[q, ra[q, j]] = mu[q] * (z[2] * Lm[q, 0, j] + z[3] * Lm[q, 1, j]
+                                           + z[4] * Lm[q, 2, j])
+    return g, dg, X, status
+
+
 if AVAILABLE:            # the callees first: numba resolves the globals when newton compiles
     _spring = numba.njit(cache=True, nogil=True)(_spring)
     _residual = numba.njit(cache=True, nogil=True)(_residual)
     _newton_matrix = numba.njit(cache=True, nogil=True)(_newton_matrix)
     _sensitivity = numba.njit(cache=True, nogil=True)(_sensitivity)
     newton = numba.njit(cache=True, nogil=True)(_newton)
+    regions_values = numba.njit(cache=True, nogil=True)(_regions_values)

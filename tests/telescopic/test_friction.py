@@ -162,3 +162,34 @@ def test_friction_multiplier_gradient_matches_finite_differences(systems):
         fd[:, j] = (at.values(lam + e)[0] - at.values(lam - e)[0]) / (2 * h)
     assert np.all(g != 0.0)
     np.testing.assert_allclose(dg, fd, rtol=0, atol=1e-5 * np.abs(dg).max())
+
+
+def test_compiled_regions_equal_the_region_by_region_values(systems):
+    """FrictionAtState.values: all regions in one compiled call (micro_motion_compiled.
+    regions_values) give the region-by-region values and gradients of the reference path
+    (normal_load per region) within the micro-motion solver's tolerance; without warm starts
+    (cold start needed) the compiled call declines and the reference path answers."""
+    from sim_core.contact import micro_motion_compiled
+    if not micro_motion_compiled.AVAILABLE:
+        pytest.skip("numba not installed")
+    ts_f, _, z = systems
+    m = ts_f.model
+    Q, Qd = _sliding_state(ts_f, z, 0.3)
+    zd = m.reduced_state(0.0, Q, Qd)[1]
+    _, lam = m.accelerations_and_multipliers(0.0, z, zd)
+    fr = m.multiplier_forces[0]
+    at = fr.at_state(0.0, Q, Qd)
+    assert at._batch is not None
+    x0 = {k: v.copy() for k, v in fr._x0.items()}
+    g, dg = at.values(lam, gradient=True)
+    fr._x0.clear()
+    fr._x0.update({k: v.copy() for k, v in x0.items()})
+    batch, at._batch = at._batch, None
+    g_ref, dg_ref = at.values(lam, gradient=True)
+    np.testing.assert_allclose(g, g_ref, rtol=1e-9)
+    np.testing.assert_allclose(dg, dg_ref, rtol=0, atol=1e-9 * np.abs(dg_ref).max())
+    fr._x0.clear()                                   # cold start: the batch declines
+    assert batch(np.asarray(lam, float), fr._x0, True) is None
+    at._batch = batch
+    g_cold, _ = at.values(lam, gradient=True)
+    np.testing.assert_allclose(g_cold, g_ref, rtol=1e-9)
