@@ -283,3 +283,24 @@ def test_offset_point_jacobian_is_the_derivative(state, moving):
                                    atol=1e-12 * np.abs(J @ v).max())
         np.testing.assert_allclose(Jp @ v, np.imag(psic) / h, rtol=1e-10,
                                    atol=1e-12 * np.abs(Jp @ v).max())
+
+
+def test_constraint_rows_from_the_complex_evaluation(state):
+    """constraint_terms takes g and G of each row as the real parts of its complex-step
+    evaluation: equal to the rows' real evaluation to round-off."""
+    ts, z, zd = state
+    m = ts.model
+    Q, Qd = m.full_state(0.3, z, zd)
+    phi, J, _, _ = constraint_terms(m.nonlinear, 0.3, Q, Qd)
+    row = 0
+    for c in m.nonlinear:
+        Qx = Q * (1.0 + 1e-6)               # other states first (real and complex): no
+        c.evaluate(Qx)                      # cache entry of the points can serve Q
+        c.evaluate(Qx + 1j * 1e-20 * Qd)
+        g, G = c.evaluate(Q.copy())
+        b = c.b(0.3)[0]
+        np.testing.assert_allclose(phi[row:row + c.m], np.real(g) - b, rtol=1e-14,
+                                   atol=1e-14 * max(np.max(np.abs(g)), 1.0))
+        np.testing.assert_allclose(J[row:row + c.m], np.real(G), rtol=1e-14,
+                                   atol=1e-14 * max(np.max(np.abs(G)), 1.0))
+        row += c.m
