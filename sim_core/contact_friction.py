@@ -109,26 +109,30 @@ class ContactFriction:
         solve: FrictionAtState.values then re-solves region by region and raises the typed
         error)."""
         from .contact import micro_motion_compiled as mmc
-        from .contact.sliding_block_contact import _KAPPA
+        from .contact.sliding_block_contact import _KAPPA, _MAX_ITER, _RTOL
         if not mmc.AVAILABLE or type(self.spring) is not SpringLaw or not regions:
             return None
-        geoms = [r[7] for r in regions]
-        if any(gm is None for gm in geoms) or len({gm.n_springs for gm in geoms}) != 1:
+        # what depends on the regions alone (geometry, multiplier rows) is stacked once
+        key = tuple(r[0] for r in regions)
+        cache = self.__dict__.setdefault("_region_stacks", {})
+        if key not in cache:
+            geoms = [r[7] for r in regions]
+            if any(gm is None for gm in geoms) or len({gm.n_springs for gm in geoms}) != 1:
+                cache[key] = None
+            else:
+                arrays = tuple(np.ascontiguousarray(np.stack([getattr(gm, a) for gm in geoms]),
+                                                    dtype=float)
+                               for a in ("A", "AT", "BfT", "AtA", "BftA"))
+                Lr = np.array([1.0 / gm.length_scale for gm in geoms])
+                rp = np.stack([np.arange(r[2].start, r[2].stop) for r in regions])
+                ra = np.stack([np.arange(r[3].start, r[3].stop) for r in regions])
+                cache[key] = (arrays, Lr, rp, ra)
+        if cache[key] is None:
             return None
-        key = tuple(id(gm) for gm in geoms)
-        stack = self.__dict__.get("_geometry_stack")
-        if stack is None or stack[0] != key:
-            arrays = tuple(np.ascontiguousarray(np.stack([getattr(gm, a) for gm in geoms]),
-                                                dtype=float)
-                           for a in ("A", "AT", "BfT", "AtA", "BftA"))
-            Lr = np.array([1.0 / gm.length_scale for gm in geoms])
-            stack = self._geometry_stack = (key, arrays, Lr)
-        _, (A, AT, BfT, AtA, BftA), Lr = stack
-        names = [r[0] for r in regions]
+        (A, AT, BfT, AtA, BftA), Lr, rp, ra = cache[key]
+        names = list(key)
         Lf = np.ascontiguousarray(np.stack([r[4] for r in regions]), dtype=float)
         Lm = np.ascontiguousarray(np.stack([r[5] for r in regions]), dtype=float)
-        rp = np.stack([np.arange(r[2].start, r[2].stop) for r in regions])
-        ra = np.stack([np.arange(r[3].start, r[3].stop) for r in regions])
         mu = np.array([r[6] for r in regions], dtype=float)
         k0, eps, kappa = self.spring.k0, self.spring.eps, _KAPPA * self.spring.k0
         nan5 = np.full(5, np.nan)
@@ -136,8 +140,8 @@ class ContactFriction:
         def values(lam, x0, gradient):
             X0 = np.stack([x0.get(nm, nan5) for nm in names]).astype(float)
             g, dg, X, status = mmc.regions_values(lam, Lf, Lm, rp, ra, mu, A, AT, BfT, AtA,
-                                                   BftA, Lr, X0, k0, eps, kappa, 1e-11, 50,
-                                                   gradient)
+                                                   BftA, Lr, X0, k0, eps, kappa, _RTOL,
+                                                   _MAX_ITER, gradient)
             if status.any():
                 return None
             for nm, x in zip(names, X):

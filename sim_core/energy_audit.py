@@ -116,7 +116,7 @@ class AuditedSystem:
         if "filter_work" in self.terms:
             P["filter_work"] = 0.0
             if self.filter is not None:
-                Qdd = m.A_pinv @ m._b(t, 2) + m.P @ zdd
+                Qdd = m._lift(t, zdd, 2)
                 P["filter_work"] = _filter_power(m, self.filter, t, Q, Qd, Qdd)
         return zdd, [P[k] for k in self.terms]
 

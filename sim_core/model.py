@@ -551,7 +551,7 @@ class Model:
         Q, Qd = self.full_state(t, z, zd)
         M, F = self.mass_force(t, Q, Qd)
         zdd, lam = self.accelerations_and_multipliers(t, z, zd)
-        R = M @ (self.A_pinv @ self._b(t, 2) + self.P @ zdd) - F
+        R = M @ self._lift(t, zdd, 2) - F
         if self.nonlinear:
             R = R - constraint_terms(self.nonlinear, t, Q, Qd)[1].T @ lam
         return self.A_pinv.T @ R
@@ -591,7 +591,7 @@ class Model:
         v = kin.J_r[0] @ Qd[idx]
         if zdd is None:
             return r, v, None
-        Qdd = self.A_pinv @ self._b(t, 2) + self.P @ zdd
+        Qdd = self._lift(t, zdd, 2)
         el = self.beams[ibeam].elements[0]
         e = self._element_at(ibeam, Q, s)
         el = self.beams[ibeam].elements[e]

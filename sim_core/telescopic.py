@@ -389,7 +389,7 @@ def _telescopic_result(ts: TelescopicSystem, t, ys, stats, error):
         z, zd = y[:n], y[n:]
         zdd, lam = m.accelerations_and_multipliers(tk, z, zd)
         Q, Qd = m.full_state(tk, z, zd)
-        Qdd = m.A_pinv @ m._b(tk, 2) + m.P @ zdd
+        Qdd = m._lift(tk, zdd, 2)
         r, J, _, _ = ts.tip(Q)
         _, Jc, _, _ = ts.tip(Q + 1e-20j * Qd)
         out["tip_position"].append(r)

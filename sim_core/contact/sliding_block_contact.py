@@ -488,6 +488,8 @@ def contact_residual(geom: SliderGeometry, spring: SpringLaw, f_c, m_c, mu_value
 # --------------------------------------------------------------------------- solver
 
 _KAPPA = 1e-10      # stiffness floor (x k0) in the Newton matrix only
+_RTOL = 1e-11       # default convergence of the micro-motion Newton (relative to the load)
+_MAX_ITER = 50      # default Newton iteration limit
 _ARMIJO = 1e-4
 
 
@@ -560,7 +562,7 @@ def _compiled_newton(geom, spring, GT, kappa_GA, c5, S, x, tol, load_scale, max_
 
 
 def normal_load(geom: SliderGeometry, spring: SpringLaw, f_c, m_c, mu: float, GT, kappa_GA,
-                x0=None, *, rtol: float = 1e-11, max_iter: int = 50, t: float = float("nan")):
+                x0=None, *, rtol: float = _RTOL, max_iter: int = _MAX_ITER, t: float = float("nan")):
     """(N = sum f_ij, dN/dc (5,), x) of the micro-motion solve: what the friction Newton needs
     (Eq. 65's normal load and its sensitivity, ContactSolution.normal_load_gradient), without
     building the ContactSolution; GT, kappa_GA from :func:`newton_matrices` at this mu.  The
@@ -580,7 +582,7 @@ def normal_load(geom: SliderGeometry, spring: SpringLaw, f_c, m_c, mu: float, GT
 
 
 def solve_micro_motion(geom: SliderGeometry, spring: SpringLaw, f_c, m_c, mu_value: float = 0.0,
-                       x0=None, *, rtol: float = 1e-11, max_iter: int = 50,
+                       x0=None, *, rtol: float = _RTOL, max_iter: int = _MAX_ITER,
                        t: float = float("nan")) -> ContactSolution:
     """Solve Eqs. 67-71 for the five micro-motions of one contact region.
 
