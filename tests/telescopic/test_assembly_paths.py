@@ -198,6 +198,12 @@ def test_element_batch_equals_the_elements_one_by_one(state):
         m.element_thread = True
     # equal to round-off (the micro-motion solves are warm-started from the previous call)
     np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12 * np.max(np.abs(a)))
+    m.element_yield = False            # no GIL hand-over after submitting: the same numbers
+    try:
+        c = m.rhs(0.3, y)
+    finally:
+        m.element_yield = True
+    np.testing.assert_allclose(a, c, rtol=1e-12, atol=1e-12 * np.max(np.abs(a)))
 
 
 def test_element_batch_non_finite_raises_in_the_callers_error_state(state):
