@@ -14,6 +14,8 @@ values -mu N, with the analytic sensitivity of the micro-motion solve (FrictionA
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from .beam.cardan import cardan_frame
@@ -27,8 +29,32 @@ def section_reaction_maps(point, Q, basis, n_angles: int = 3):
     exerts on its *second* body b (g = r_a - r_b), section components (s, t, b):
     f_sec = Lf lam_point (f = -lambda in global components) and m_sec = Lm lam_angles (the
     moment from the Cardan-angle multipliers, m = -T^-T lambda_psi, Eq. 31).  ``n_angles`` = 2
-    without the twist row (effects.torsion = false).  Returns (Lf (3, 3), Lm (3, n_angles))."""
+    without the twist row (effects.torsion = false).  Returns (Lf (3, 3), Lm (3, n_angles)).
+
+    T maps the angle rates to the angular velocity (omega_s, omega_t, omega_b) (Eq. 31):
+    T = [[sin b, 0, 1], [cos b cos g, sin g, 0], [-cos b sin g, cos g, 0]], det T = cos b, so
+    T^-T = [[0, 0, 1], [cos g / cos b, sin g, -tan b cos g], [-sin g / cos b, cos g,
+    tan b sin g]] in closed form (``_section_reaction_maps_inv`` is the same by inversion)."""
     _, _, psi, _ = point(Q)
+    if np.iscomplexobj(psi):
+        return _section_reaction_maps_inv(psi, basis, n_angles)
+    a, b, g = float(psi[0]), float(psi[1]), float(psi[2])
+    ca, sa, cb, sb, cg, sg = math.cos(a), math.sin(a), math.cos(b), math.sin(b), math.cos(g), \
+        math.sin(g)
+    # rows e_s, e_t, e_b of the Cardan frame (Eq. 24, cardan_frame) in the reference basis
+    R = np.array([[sb, -sa * cb, ca * cb],
+                  [cb * cg, ca * sg + sa * sb * cg, sa * sg - ca * sb * cg],
+                  [-cb * sg, ca * cg - sa * sb * sg, sa * cg + ca * sb * sg]])
+    tb = sb / cb
+    Lm = np.array([[0.0, 0.0, -1.0],
+                   [-cg / cb, -sg, tb * cg],
+                   [sg / cb, -cg, -tb * sg]])
+    return -(R @ basis.T), Lm[:, :n_angles]
+
+
+def _section_reaction_maps_inv(psi, basis, n_angles: int):
+    """section_reaction_maps from the angles by the frame of cardan_frame and the inverse of T
+    (the reference of the closed form; complex-step safe)."""
     frame = cardan_frame(*psi) @ basis.T                 # rows e_t, e_b, e_s (global)
     sb, cb = np.sin(psi[1]), np.cos(psi[1])
     sg, cg = np.sin(psi[2]), np.cos(psi[2])

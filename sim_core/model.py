@@ -465,10 +465,14 @@ class Model:
         if not self.nonlinear:
             Mr, Fr = self._reduced_mass_force_at(t, Q, Qd, Qdd_p)
             return sla.solve(Mr, Fr, assume_a="pos"), np.zeros(0)
-        # the element batch runs (on the worker thread) while the constraint rows are formed
+        # the element batch runs (on the worker thread) while the constraint rows and the
+        # multiplier forces' state-only parts (friction: section maps, mu(s_dot)) are formed
         elements = self._element_blocks_started(t, Q, Qd) if self._sel is not None else None
+        newton = bool(self.multiplier_forces) and self.multiplier_newton and all(
+            hasattr(mf, "at_state") for mf in self.multiplier_forces)
         try:
             phi, J, dphi, c_rhs = constraint_terms(self.nonlinear, t, Q, Qd)
+            ats = [mf.at_state(t, Q, Qd) for mf in self.multiplier_forces] if newton else None
         except BaseException:
             if elements is not None:            # do not leave the batch running
                 try:
@@ -483,8 +487,8 @@ class Model:
         if not self.multiplier_forces:
             return kkt_accelerations(Mr, Fr, self._times_P(J), c_rhs)
         solve = kkt_factor(Mr, self._times_P(J), blocks if self.kkt_blocks else None)
-        if self.multiplier_newton and all(hasattr(mf, "at_state") for mf in self.multiplier_forces):
-            return self._multiplier_newton(t, Q, Qd, solve, Fr, c_rhs)
+        if newton:
+            return self._multiplier_newton(ats, solve, Fr, c_rhs)
         zdd, lam = solve(Fr, c_rhs)
         for _ in range(self.multiplier_max_iter):
             dF = sum(mf.forces(t, Q, Qd, lam) for mf in self.multiplier_forces)
@@ -495,7 +499,7 @@ class Model:
                 break
         return zdd, lam
 
-    def _multiplier_newton(self, t, Q, Qd, solve, Fr, c_rhs):
+    def _multiplier_newton(self, ats, solve, Fr, c_rhs):
         """Multiplier-dependent forces E g(lambda) on k coordinates (friction: the contact
         coordinates, Section 8.3): the saddle-point solution is affine in g,
         (z_ddot, lambda) = (z0, lam0) + (Z, L) g  (one factorisation, k + 1 right-hand sides),
@@ -504,8 +508,8 @@ class Model:
         sensitivity, ContactSolution.normal_load_gradient).  A Newton step that does not reduce |r|
         is replaced by the fixed-point step g <- g(lambda).  Stops when a Newton step changes
         lambda by less than multiplier_tol (relative to max |lambda|, at least 1); the step is
-        taken, its error is of the order of its square."""
-        ats = [mf.at_state(t, Q, Qd) for mf in self.multiplier_forces]
+        taken, its error is of the order of its square.  ``ats``: the multiplier forces at the
+        state (their ``at_state``)."""
         idx = np.concatenate([a.coords for a in ats])
         k = len(idx)
         if k == 0:

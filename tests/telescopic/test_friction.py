@@ -193,3 +193,28 @@ def test_compiled_regions_equal_the_region_by_region_values(systems):
     at._batch = batch
     g_cold, _ = at.values(lam, gradient=True)
     np.testing.assert_allclose(g_cold, g_ref, rtol=1e-9)
+
+
+def test_section_reaction_maps_closed_form_equals_the_inverse():
+    """The closed-form T^-T of section_reaction_maps (det T = cos beta) against the frame of
+    cardan_frame and numpy's inverse, at random angles and a random orthonormal basis, for 3
+    and 2 angle rows; a complex-step state takes the inverse path."""
+    from sim_core.contact_friction import _section_reaction_maps_inv, section_reaction_maps
+    rng = np.random.default_rng(7)
+    basis, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    for _ in range(20):
+        psi = rng.uniform(-1.2, 1.2, size=3)
+
+        def point(Q, psi=psi):
+            return None, None, psi, None
+        for n in (3, 2):
+            Lf, Lm = section_reaction_maps(point, None, basis, n)
+            Lf0, Lm0 = _section_reaction_maps_inv(psi, basis, n)
+            np.testing.assert_allclose(Lf, Lf0, rtol=0, atol=1e-14)
+            np.testing.assert_allclose(Lm, Lm0, rtol=1e-13, atol=1e-13)
+    psi_c = psi + 1e-20j
+
+    def point_c(Q):
+        return None, None, psi_c, None
+    Lf, Lm = section_reaction_maps(point_c, None, basis, 3)
+    assert np.iscomplexobj(Lm)
