@@ -97,21 +97,36 @@ def _factor(Mr, C, blocks, lens, r):
                 A[i, j] = Mr[blocks[q, i], blocks[q, j]]
         if _chol(A, nq) != 0:
             return False, facs, Bs, Ys, S, np.zeros(nb, dtype=np.int32), CT
-        Yt = np.zeros((nb, L))                   # Y^T in C order: the Fortran (L, nb) block
         for i in range(nq):
             bi = blocks[q, i]
             for j in range(nr):
                 Bs[q, i, j] = Mr[bi, r[j]]
             for j in range(m):
                 Bs[q, i, nr + j] = C[j, bi]
+        # only the border columns that touch this block (a constraint row on other beams, a
+        # border coordinate not coupled to it: a zero column of B, hence of Y = A^-1 B)
+        act = np.empty(nb, dtype=np.int64)
+        na = 0
         for j in range(nb):
             for i in range(nq):
-                Yt[j, i] = Bs[q, i, j]
+                if Bs[q, i, j] != 0.0:
+                    act[na] = j
+                    na += 1
+                    break
+        Yt = np.zeros((na, L))                   # Y^T in C order: the Fortran (L, na) block
+        Bt = np.empty((na, nq))
+        for jj in range(na):
+            for i in range(nq):
+                Bt[jj, i] = Bs[q, i, act[jj]]
+                Yt[jj, i] = Bt[jj, i]
         _chol_solve(A, nq, Yt)
-        for i in range(nq):
-            for j in range(nb):
-                Ys[q, i, j] = Yt[j, i]
-        S -= np.dot(Bs[q].T.copy(), Ys[q])       # zero rows beyond nq add nothing
+        for jj in range(na):
+            for i in range(nq):
+                Ys[q, i, act[jj]] = Yt[jj, i]
+        P = np.dot(Bt, Yt[:, :nq].T.copy())      # B^T Y on the active columns
+        for a in range(na):
+            for c in range(na):
+                S[act[a], act[c]] -= P[a, c]
     St = S.T.copy()                              # C order of S^T = Fortran order of S
     piv = np.zeros(nb, dtype=np.int32)
     nn = _i32(nb)
