@@ -167,3 +167,33 @@ def test_bdf_newton_limit_is_raised_only_inside_bdf_steps():
     # evaluation the raised one
     first = seen.index(BDF_NEWTON_ITERATIONS)
     assert set(seen[:first]) == {before} and set(seen[first:]) == {BDF_NEWTON_ITERATIONS}
+
+
+def test_second_order_newton_lu_equals_the_whole_lu():
+    """BDF's Newton matrix I - c J for J = [[0, I], [A_z, A_v]] by its Schur complement
+    (n x n) solves like the LU of the whole 2n x 2n matrix; a matrix without that exact
+    structure takes the whole LU."""
+    from scipy.integrate import BDF
+
+    from sim_core.simulate import SecondOrderNewtonLU
+
+    rng = np.random.default_rng(5)
+    n = 6
+    J = np.zeros((2 * n, 2 * n))
+    J[:n, n:] = np.eye(n)
+    J[n:] = rng.normal(size=(n, 2 * n)) * 1e4                       # stiff rows
+    solver = BDF(lambda t, y: J @ y, 0.0, np.ones(2 * n), 1.0, jac=J)
+    newton = SecondOrderNewtonLU(solver)
+    b = rng.normal(size=2 * n)
+    for c in (1e-4, 3e-2):
+        A = np.eye(2 * n) - c * J
+        LU = newton.lu(A.copy())
+        assert LU[0] == "schur"
+        np.testing.assert_allclose(newton.solve_lu(LU, b.copy()), np.linalg.solve(A, b),
+                                   rtol=1e-10, atol=1e-12)
+    A = np.eye(2 * n) - 1e-3 * J
+    A[0, n] *= 1.0 + 1e-15                               # not exactly -c I: the whole LU
+    LU = newton.lu(A.copy())
+    assert LU[0] == "full"
+    np.testing.assert_allclose(newton.solve_lu(LU, b.copy()), np.linalg.solve(A, b),
+                               rtol=1e-10, atol=1e-12)
