@@ -62,6 +62,11 @@ class NonlinearConstraint:
 
 _H = 1e-20
 
+# material points: kinematics, rigid offset and the full-length Jacobians in one compiled call
+# (point_compiled.point_full); False: the compiled kinematics and the rest in numpy (the
+# reference of the tests)
+POINTS_IN_ONE_CALL = True
+
 
 def dependencies(points, Q: Vec) -> np.ndarray | None:
     """Union of the coordinates the point functions depend on at Q; None if one of them does not
@@ -258,6 +263,9 @@ def material_point(model, ibeam: int, s_fixed: float | None = None, s_index: int
     def _evaluate(Q, e, idx):
         s = Q[s_index] if s_index is not None else s_fixed
         el = beam.elements[e]
+        if point_compiled.AVAILABLE and POINTS_IN_ONE_CALL:
+            # kinematics, offset and the full-length Jacobians in one compiled call
+            return point_compiled.point_full(el, Q, idx, s_index, s, o_sec, N)
         if point_compiled.AVAILABLE:                      # the same kinematics, compiled
             r, rp, J_r, J_psi, angles, psi_prime, frame, tmat = point_compiled.point_kinematics(
                 el, Q[idx], s)

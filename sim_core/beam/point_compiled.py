@@ -96,8 +96,53 @@ def _point(qe, s, n, D_all, pow_p, pow_t, basis, i_s1):
             frame[0].copy(), tmat[0].copy(), total)
 
 
+def _point_full(Q, idx, s_index, s, o_sec, N, n, D_all, pow_p, pow_t, basis, i_s1):
+    """(r, dr/dQ (3, N), angles, dangles/dQ (3, N), finite-check sum) of a material point on
+    the full coordinates: _point on the element's coordinates Q[idx], the rigid offset o_sec
+    (axial, lateral, vertical; empty: none) in the section frame, and the moving point's
+    s column (s_index >= 0).  The same algebra as the Python of
+    :func:`sim_core.constraints.material_point` (its reference path)."""
+    dt = Q.dtype
+    nq = idx.shape[0]
+    qe = np.empty(nq, dtype=dt)
+    for k in range(nq):
+        qe[k] = Q[idx[k]]
+    r, rp, J_r, J_psi, angles, psi_prime, frame, tmat, total = _point(
+        qe, s, n, D_all, pow_p, pow_t, basis, i_s1)
+    if o_sec.shape[0] == 3:              # frame rows e_t, e_b, e_s; tmat columns (s, t, b)
+        o = o_sec[1] * frame[0] + o_sec[2] * frame[1] + o_sec[0] * frame[2]
+        R = np.empty((3, 3), dtype=dt)   # R = frame[[2, 0, 1]].T @ tmat
+        for i in range(3):
+            for j in range(3):
+                R[i, j] = frame[2, i] * tmat[0, j] + frame[0, i] * tmat[1, j] \
+                    + frame[1, i] * tmat[2, j]
+        ox = np.zeros((3, 3), dtype=dt)  # J += (R dpsi) x o = ox R dpsi
+        ox[0, 1] = o[2]
+        ox[0, 2] = -o[1]
+        ox[1, 0] = -o[2]
+        ox[1, 2] = o[0]
+        ox[2, 0] = o[1]
+        ox[2, 1] = -o[0]
+        oxR = np.dot(ox, R)
+        J_r = J_r + np.dot(oxR, J_psi)
+        rp = rp + np.dot(oxR, psi_prime)
+        r = r + o
+    J = np.zeros((3, N), dtype=dt)
+    Jp = np.zeros((3, N), dtype=dt)
+    for i in range(3):
+        for k in range(nq):
+            J[i, idx[k]] = J_r[i, k]
+            Jp[i, idx[k]] = J_psi[i, k]
+        if s_index >= 0:
+            J[i, s_index] += rp[i]
+            Jp[i, s_index] += psi_prime[i]
+    return r, J, angles, Jp, total
+
+
 if AVAILABLE:
     _compiled_point = cardan_compiled.numba.njit(cache=True, nogil=True)(_point)
+    _point = _compiled_point                   # the callee of _point_full
+    _compiled_point_full = cardan_compiled.numba.njit(cache=True, nogil=True)(_point_full)
 
 
 def point_kinematics(el, qe, s):
@@ -109,3 +154,21 @@ def point_kinematics(el, qe, s):
                                   el.i_s1)
     cardan_compiled.check_finite(total, "point kinematics")
     return tuple(out)
+
+
+_NO_OFFSET = np.zeros(0)
+
+
+def point_full(el, Q, idx, s_index, s, o_sec, N):
+    """(r, dr/dQ (3, N), (alpha, beta, gamma), d(alpha, beta, gamma)/dQ (3, N)) of element
+    ``el`` (global coordinates ``idx``) at the material coordinate s (real or complex-step), with
+    the rigid offset o_sec (None: none) and the moving point's coordinate s_index (None: a
+    fixed material point); one compiled call (see _point_full)."""
+    dt = np.result_type(Q, s, float)
+    Q = np.ascontiguousarray(Q, dtype=dt)
+    r, J, angles, Jp, total = _compiled_point_full(
+        Q, idx, -1 if s_index is None else int(s_index), dt.type(s),
+        _NO_OFFSET if o_sec is None else o_sec, int(N), el.n, el._D_all, el._pow_p, el._pow_t,
+        el.G, el.i_s1)
+    cardan_compiled.check_finite(total, "point kinematics")
+    return r, J, angles, Jp

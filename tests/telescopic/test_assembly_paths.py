@@ -310,3 +310,40 @@ def test_constraint_rows_from_the_complex_evaluation(state):
         np.testing.assert_allclose(J[row:row + c.m], np.real(G), rtol=1e-14,
                                    atol=1e-14 * max(np.max(np.abs(G)), 1.0))
         row += c.m
+
+
+@pytest.mark.parametrize("kind", ["moving", "fixed_offset", "moving_offset"])
+def test_point_in_one_compiled_call_equals_the_reference(state, kind, monkeypatch):
+    """A material point's kinematics, rigid offset and full-length Jacobians in one compiled
+    call (point_compiled.point_full) against the compiled kinematics with the rest in numpy,
+    for a real and a complex-step state (two point functions, each with its own cache)."""
+    from sim_core import constraints
+    from sim_core.beam import point_compiled
+    if not point_compiled.AVAILABLE:
+        pytest.skip("numba not installed")
+    ts, z, zd = state
+    m = ts.model
+    ibeam, kw = {"moving": (1, dict(s_index=ts.s3_index[1])),
+                 "fixed_offset": (1, dict(s_fixed=1.3, offset=(0.3, -0.1, 0.2))),
+                 "moving_offset": (0, dict(s_index=ts.s2_index[0],
+                                           offset=(-0.2, 0.05, 0.1)))}[kind]
+    cache = m.__dict__.setdefault("_material_points", {})
+    saved = dict(cache)
+    try:
+        cache.clear()
+        fast = material_point(m, ibeam, **kw)
+        cache.clear()
+        ref = material_point(m, ibeam, **kw)
+    finally:
+        cache.clear()
+        cache.update(saved)
+    assert fast is not ref
+    Q, Qd = m.full_state(0.3, z, zd)
+    for X in (Q, Q + 1e-20j * Qd):
+        monkeypatch.setattr(constraints, "POINTS_IN_ONE_CALL", True)
+        a = fast(X)
+        monkeypatch.setattr(constraints, "POINTS_IN_ONE_CALL", False)
+        b = ref(X)
+        assert np.iscomplexobj(a[1]) == np.iscomplexobj(X)
+        for u, v in zip(a, b):
+            np.testing.assert_allclose(u, v, rtol=1e-13, atol=1e-13 * max(np.max(np.abs(v)), 1))
