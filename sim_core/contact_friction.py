@@ -173,6 +173,21 @@ class ContactFriction:
             for nm, x in zip(names, X):
                 x0[nm] = x
             return g, (dg if gradient else None)
+
+        def newton(lam0, L, x0, tol, max_iter):
+            # the whole multiplier Newton (Model._multiplier_newton) in one compiled call; None
+            # where a region needs the reference path (the caller runs the Python loop)
+            X0 = np.stack([x0.get(nm, nan5) for nm in names]).astype(float)
+            g, X, ok = mmc.multiplier_newton(
+                np.ascontiguousarray(lam0, dtype=float), np.ascontiguousarray(L, dtype=float),
+                Lf, Lm, rp, ra, mu, A, AT, BfT, AtA, BftA, Lr, X0, k0, eps, kappa, _RTOL,
+                _MAX_ITER, float(tol), int(max_iter))
+            if not ok:
+                return None
+            for nm, x in zip(names, X):
+                x0[nm] = x
+            return g
+        values.newton = newton
         return values
 
     def solve_regions(self, Q, Qd, lam):
@@ -239,6 +254,14 @@ class FrictionAtState:
             self._mats = [None if geom is None else newton_matrices(geom, self.owner.spring, mu)
                           for (_, _, _, _, _, _, mu, geom) in self.regions]
         return self._mats
+
+    def newton(self, lam0, L, tol: float, max_iter: int):
+        """g solving g = g(lam0 + L g) by the multiplier Newton of Model._multiplier_newton
+        in one compiled call (micro_motion_compiled.multiplier_newton), or None where it does
+        not apply (no compiled batch, a region that needs the reference path)."""
+        if self._batch is None:
+            return None
+        return self._batch.newton(lam0, L, self.owner._x0, tol, max_iter)
 
     def solve_regions(self, lam):
         out = []

@@ -65,6 +65,9 @@ class Model:
     multiplier_tol: float = 1e-8
     multiplier_newton: bool = True     # False: the fixed point even where at_state is offered
     multiplier_max_iter: int = 8
+    # the multiplier Newton's loop in one compiled call where the force offers it (friction:
+    # FrictionAtState.newton); False: the Python loop (the reference)
+    multiplier_newton_compiled: bool = True
     baumgarte: tuple[float, float] = (10.0, 10.0)          # xi1, xi2 in 1/s (second seed Eq. 8)
     # the saddle-point system by block elimination over the beams (constraints.kkt_factor)
     # where M_r is block-diagonal in them; False: the LU of the whole matrix (the reference)
@@ -518,6 +521,10 @@ class Model:
                     np.column_stack([c_rhs, np.zeros((len(c_rhs), k))]))
         zdd0, Z = sol[0][:, 0], sol[0][:, 1:]
         lam0, L = sol[1][:, 0], sol[1][:, 1:]
+        if self.multiplier_newton_compiled and len(ats) == 1 and hasattr(ats[0], "newton"):
+            g = ats[0].newton(lam0, L, self.multiplier_tol, self.multiplier_max_iter)
+            if g is not None:                   # the loop below in one compiled call
+                return zdd0 + Z @ g, lam0 + L @ g
 
         def values(g):
             lam = lam0 + L @ g

@@ -199,6 +199,53 @@ def _regions_values(lam, Lf, Lm, rp, ra, mu, A, AT, BfT, AtA, BftA, Lr, X0, k0, 
     return g, dg, X, status
 
 
+def _multiplier_newton(lam0, L, Lf, Lm, rp, ra, mu, A, AT, BfT, AtA, BftA, Lr, X0, k0, eps,
+                       kappa, rtol, max_iter_mm, tol, max_iter):
+    """The friction-multiplier Newton of ``sim_core.model.Model._multiplier_newton`` in one
+    compiled call, for one multiplier force whose regions all take :func:`regions_values`:
+    r(g) = g - g(lam0 + L g) = 0 by Newton with the matrix I - (dg/dlam) L, the fixed-point
+    step where a Newton step does not reduce max |r|, stop when a step changes lambda by less
+    than ``tol`` relative to max(max |lambda|, 1).  The same operations in the same order as
+    the Python loop.  Returns (g, X (the micro-motions to warm-start from), ok); ok False where
+    a region needs the reference path (status != 0): the caller then runs the Python loop."""
+    k = L.shape[1]
+    g = np.zeros(k)
+    lam = lam0 + np.dot(L, g)
+    gv, dg, X, st = regions_values(lam, Lf, Lm, rp, ra, mu, A, AT, BfT, AtA, BftA, Lr, X0,
+                                   k0, eps, kappa, rtol, max_iter_mm, True)
+    if st.any():
+        return g, X0, False
+    r = g - gv
+    eye = np.eye(k)
+    for _ in range(max_iter):
+        step = np.linalg.solve(eye - np.dot(dg, L), -r)
+        g_new = g + step
+        dlam = np.dot(L, step)
+        if np.max(np.abs(dlam)) < tol * max(np.max(np.abs(lam + dlam)), 1.0):
+            g = g_new
+            break
+        lam_new = lam0 + np.dot(L, g_new)
+        gv_new, dg_new, Xn, st = regions_values(lam_new, Lf, Lm, rp, ra, mu, A, AT, BfT, AtA,
+                                                BftA, Lr, X, k0, eps, kappa, rtol, max_iter_mm,
+                                                True)
+        if st.any():
+            return g, X0, False
+        X = Xn
+        r_new = g_new - gv_new
+        if np.max(np.abs(r_new)) > np.max(np.abs(r)):          # safeguard: fixed-point step
+            g_new = gv.copy()
+            lam_new = lam0 + np.dot(L, g_new)
+            gv_new, dg_new, Xn, st = regions_values(lam_new, Lf, Lm, rp, ra, mu, A, AT, BfT,
+                                                    AtA, BftA, Lr, X, k0, eps, kappa, rtol,
+                                                    max_iter_mm, True)
+            if st.any():
+                return g, X0, False
+            X = Xn
+            r_new = g_new - gv_new
+        g, lam, gv, dg, r = g_new, lam_new, gv_new, dg_new, r_new
+    return g, X, True
+
+
 if AVAILABLE:            # the callees first: numba resolves the globals when newton compiles
     _spring = numba.njit(cache=True, nogil=True)(_spring)
     _residual = numba.njit(cache=True, nogil=True)(_residual)
@@ -206,3 +253,4 @@ if AVAILABLE:            # the callees first: numba resolves the globals when ne
     _sensitivity = numba.njit(cache=True, nogil=True)(_sensitivity)
     newton = numba.njit(cache=True, nogil=True)(_newton)
     regions_values = numba.njit(cache=True, nogil=True)(_regions_values)
+    multiplier_newton = numba.njit(cache=True, nogil=True)(_multiplier_newton)

@@ -123,6 +123,7 @@ def test_multiplier_newton_matches_the_converged_fixed_point(systems, distributi
 
     try:
         cf.FrictionAtState.values = counted
+        m.multiplier_newton_compiled = False    # the Python loop: its evaluations are counted
         m.multiplier_newton, m.multiplier_tol, m.multiplier_max_iter = False, 1e-13, 60
         a_ref, lam_ref = m.accelerations_and_multipliers(0.0, z, zd)
         m.multiplier_tol, m.multiplier_max_iter = saved[2:]
@@ -136,6 +137,7 @@ def test_multiplier_newton_matches_the_converged_fixed_point(systems, distributi
     finally:
         cf.FrictionAtState.values = values
         m.multiplier_newton = True
+        m.multiplier_newton_compiled = True
         fr.distribution, fr.regions, m.multiplier_tol, m.multiplier_max_iter = saved
     # the friction changes the multipliers by O(10 %): a 1e-9 agreement needs both solves
     assert np.max(np.abs(lam - lam_ref)) < 1e-9 * np.max(np.abs(lam_ref))
@@ -218,3 +220,42 @@ def test_section_reaction_maps_closed_form_equals_the_inverse():
         return None, None, psi_c, None
     Lf, Lm = section_reaction_maps(point_c, None, basis, 3)
     assert np.iscomplexobj(Lm)
+
+
+@pytest.mark.parametrize("v", [0.2, 0.004, -0.05])
+def test_compiled_multiplier_newton_equals_the_python_loop(systems, v):
+    """The friction-multiplier Newton in one compiled call (FrictionAtState.newton,
+    micro_motion_compiled.multiplier_newton) against the Python loop of
+    Model._multiplier_newton, sliding (|v| > 2 v_eps), in the stick band and backwards: the
+    same operations, so the same accelerations and multipliers to round-off (both warm-start
+    the micro-motions from the same solutions)."""
+    from sim_core.contact import micro_motion_compiled
+    if not micro_motion_compiled.AVAILABLE:
+        pytest.skip("numba not installed")
+    ts_f, _, z = systems
+    m = ts_f.model
+    Q, Qd = _sliding_state(ts_f, z, v)
+    zd = m.reduced_state(0.0, Q, Qd)[1]
+    fr = m.multiplier_forces[0]
+    m.accelerations_and_multipliers(0.0, z, zd)          # warm starts at this state
+    x0 = {k: x.copy() for k, x in fr._x0.items()}
+    calls = []
+    newton = type(m.multiplier_forces[0].at_state(0.0, Q, Qd)).newton
+
+    def counted(self, *a):
+        out = newton(self, *a)
+        calls.append(out is not None)
+        return out
+    try:
+        type(m.multiplier_forces[0].at_state(0.0, Q, Qd)).newton = counted
+        a, lam = m.accelerations_and_multipliers(0.0, z, zd)
+        fr._x0.clear()
+        fr._x0.update(x0)
+        m.multiplier_newton_compiled = False
+        a_ref, lam_ref = m.accelerations_and_multipliers(0.0, z, zd)
+    finally:
+        type(m.multiplier_forces[0].at_state(0.0, Q, Qd)).newton = newton
+        m.multiplier_newton_compiled = True
+    assert calls == [True]                               # the compiled path was taken
+    np.testing.assert_allclose(lam, lam_ref, rtol=0, atol=1e-12 * np.max(np.abs(lam_ref)))
+    np.testing.assert_allclose(a, a_ref, rtol=0, atol=1e-12 * np.max(np.abs(a_ref)))
