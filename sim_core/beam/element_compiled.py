@@ -101,11 +101,15 @@ def _strain_arguments(RR, TT, g, x_l, x_p):
     x_p[7] = TT[g, 2]
 
 
-def _convective(qe, qde, cstep, n, D_all, q_pos, q_sub, pow_p, pow_t, basis, i_s1,
+def _convective(qe, qde, cstep, n, q_rows, q_pos, q_sub, pow_p, pow_t, basis, i_s1,
                 with_strain):
     """Material convective terms at the Gauss points (Model.element_context):
     a = (J_r)^. q_dot (G, 3), w_dot = (J_w)^. q_dot (G, 3), eps_ddot = (B_s)^. q_dot (G, 4)
-    (zeros unless with_strain), by complex step in q along q_dot at the fixed material s."""
+    (zeros unless with_strain), by complex step in q along q_dot at the fixed material s.
+    The basis rows at the complex xi of a Gauss point: xi = (s - s_1)/l - sub (Eq. 10) has the
+    real part of the point's table (q_rows[:, 0]) and Im xi = -(Im s_1 + chi Im l)/Re l (to
+    O(h^2), chi = sub + xi), so rows(xi) = rows + i Im(xi) d rows/d xi (q_rows[:, 1]) exactly
+    in double precision for the step h = 1e-20."""
     G = q_pos.shape[0]
     na = n + 4
     npos = 3 * na
@@ -114,42 +118,27 @@ def _convective(qe, qde, cstep, n, D_all, q_pos, q_sub, pow_p, pow_t, basis, i_s
     qc = np.empty(nq, dtype=np.complex128)
     for k in range(nq):
         qc[k] = qe[k] + 1j * (cstep * qde[k])
-    s1r = qe[i_s1]
-    ellr = (qe[i_s1 + 1] - s1r) / (n - 1)
+    ellr = (qe[i_s1 + 1] - qe[i_s1]) / (n - 1)
     s1 = qc[i_s1]
     ell = (qc[i_s1 + 1] - s1) / (n - 1)                               # Eq. 5
     lpow = cardan_compiled.length_powers(ell)
-    nrow = D_all.shape[2]
     X = np.empty((G, 7, na), dtype=np.complex128)
     Y = np.empty((G, 5, nt), dtype=np.complex128)
     ds = np.empty((G, 2), dtype=np.complex128)
-    rre = np.empty(nrow)                 # basis rows sum_p xi^p D[sub, p] (D real): real and
-    rim = np.empty(nrow)                 # imaginary parts as two real sums
     for g in range(G):
-        sub = q_sub[g]
-        s = s1r + q_pos[g] * ellr                                     # the real material point
-        xi = (s - s1) / ell - sub                                     # Eq. 10, complex
-        rre[:] = 0.0
-        rim[:] = 0.0
-        p_xi = 1.0 + 0.0j
-        for p in range(6):
-            pr = p_xi.real
-            pi = p_xi.imag
-            for k in range(nrow):
-                dk = D_all[sub, p, k]
-                rre[k] += pr * dk
-                rim[k] += pi * dk
-            p_xi = p_xi * xi
+        xi_im = -(s1.imag + q_pos[g] * ell.imag) / ellr               # Im xi (Eq. 10)
         for i in range(7):
             for a in range(na):
                 k = i * na + a
-                X[g, i, a] = (rre[k] + 1j * rim[k]) * lpow[pow_p[i, a]]
+                X[g, i, a] = (q_rows[g, 0, k] + 1j * (xi_im * q_rows[g, 1, k])) \
+                    * lpow[pow_p[i, a]]
         off = 7 * na
         for i in range(5):
             for a in range(nt):
                 k = off + i * nt + a
-                Y[g, i, a] = (rre[k] + 1j * rim[k]) * lpow[pow_t[i, a]]
-        frac = (sub + xi) / (n - 1)
+                Y[g, i, a] = (q_rows[g, 0, k] + 1j * (xi_im * q_rows[g, 1, k])) \
+                    * lpow[pow_t[i, a]]
+        frac = (q_pos[g] + 1j * xi_im) / (n - 1)
         ds[g, 0] = 1.0 - frac
         ds[g, 1] = frac
     RR, TT, eps, d, dpsi, tmat = _centre_line(qc, X, Y, n, basis)
@@ -219,7 +208,7 @@ def _convective(qe, qde, cstep, n, D_all, q_pos, q_sub, pow_p, pow_t, basis, i_s
     return a_out, w_out, e_out
 
 
-def _mass_force(qe, qde, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_sub, D_all, basis,
+def _mass_force(qe, qde, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_sub, q_rows, basis,
                 i_s1, rhoA, Jrot, D, h, grav, inertia, elasticity, gravity, needs_mass, cstep,
                 qdde):
     """(Me (nq, nq) or (0, 0), Fe (nq,)) of one element; see element_mass_force.  A non-empty
@@ -309,7 +298,7 @@ def _mass_force(qe, qde, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_sub,
     # per-row loads v: Fe = v . J (one matrix-vector product) + the dl/dQ energy terms
     conv = inertia or filt
     if conv:
-        acc_c, wdot_c, eddot_c = _convective(qe, qde, cstep, n, D_all, q_pos, q_sub, pow_p,
+        acc_c, wdot_c, eddot_c = _convective(qe, qde, cstep, n, q_rows, q_pos, q_sub, pow_p,
                                              pow_t, basis, i_s1, filt)
     v = np.zeros((G, K))
     Fe_extra = np.zeros(nq)
@@ -401,7 +390,7 @@ def _mass_force(qe, qde, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_sub,
     return _gram(A.reshape(G * km, nq)), Fe
 
 
-def _mass_force_batch(QE, QDE, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_sub, D_all,
+def _mass_force_batch(QE, QDE, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_sub, q_rows,
                       bases, i_s1, rhoAs, Jrots, Ds, h, grav, inertia, elasticity, gravity, cstep,
                       no_acc):
     """_mass_force of E elements with the same tables (rows of QE, QDE; per element the
@@ -411,7 +400,7 @@ def _mass_force_batch(QE, QDE, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, 
     Fs = np.empty((E, nq))
     for e in range(E):
         M, F = _compiled_mass_force(QE[e], QDE[e], n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w,
-                                    q_pos, q_sub, D_all, bases[e], i_s1, rhoAs[e], Jrots[e],
+                                    q_pos, q_sub, q_rows, bases[e], i_s1, rhoAs[e], Jrots[e],
                                     Ds[e], h, grav, inertia, elasticity, gravity, True, cstep,
                                     no_acc)
         Ms[e] = M
@@ -420,7 +409,7 @@ def _mass_force_batch(QE, QDE, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, 
 
 
 def _differences_batch(QE, QDE, QDDE, HQ, HQD, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos,
-                       q_sub, D_all, bases, i_s1, rhoAs, Jrots, Ds, h, grav, inertia,
+                       q_sub, q_rows, bases, i_s1, rhoAs, Jrots, Ds, h, grav, inertia,
                        elasticity, gravity, cstep, no_acc):
     """Forward differences of E elements (the structured Jacobian's element columns,
     sim_core.state_jacobian): per element d(F - M qdd)/dq and dF/dq_dot (nq, nq), steps HQ,
@@ -431,7 +420,7 @@ def _differences_batch(QE, QDE, QDDE, HQ, HQD, n, q_phi, q_psi, pow_p, pow_t, q_
     for e in range(E):
         qe = QE[e].copy()
         qde = QDE[e].copy()
-        args = (n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_sub, D_all, bases[e], i_s1,
+        args = (n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_sub, q_rows, bases[e], i_s1,
                 rhoAs[e], Jrots[e], Ds[e], h, grav, inertia, elasticity, gravity, False, cstep)
         R0 = _compiled_mass_force(qe, qde, *args, QDDE[e])[1]
         F0 = _compiled_mass_force(qe, qde, *args, no_acc)[1]
@@ -533,7 +522,7 @@ def element_mass_force(el, qe, qde, rhoA, Jrot, D, h=0.0, g=None, inertia=True,
         needs_mass = False
     Me, Fe = _compiled_mass_force(
         qe, qde, el.n, el._q_phi, el._q_psi, el._pow_p, el._pow_t, el._q_ds_dchi, el.q_w,
-        el._q_pos, el.q_sub, el._D_all, el.G, el.i_s1, float(rhoA),
+        el._q_pos, el.q_sub, el._q_rows, el.G, el.i_s1, float(rhoA),
         np.ascontiguousarray(Jrot, dtype=float), np.ascontiguousarray(D, dtype=float),
         float(h), grav, bool(inertia), bool(elasticity), bool(np.any(grav != 0.0)),
         bool(needs_mass), float(cstep),
@@ -544,7 +533,7 @@ def element_mass_force(el, qe, qde, rhoA, Jrot, D, h=0.0, g=None, inertia=True,
 
 
 _TABLES = ("_q_phi", "_q_psi", "_pow_p", "_pow_t", "_q_ds_dchi", "q_w", "_q_pos", "q_sub",
-           "_D_all")
+           "_q_rows")
 
 
 class ElementBatch:

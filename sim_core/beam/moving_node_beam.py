@@ -281,6 +281,15 @@ class SplineElement:
         Dt = np.einsum("pkm,ima->ipka", fac[:4, :3, :4], b.tor_coeffs)[:, :, kt] * self._fac_t
         Dt = np.concatenate([Dt, np.zeros((n - 1, 2) + Dt.shape[2:])], axis=1)
         self._D_all = np.concatenate([Dp.reshape(n - 1, 6, -1), Dt.reshape(n - 1, 6, -1)], 2)
+        # at the quadrature points: the rows sum_p xi^p D[sub, p, :] and their xi-derivatives
+        # sum_p p xi^(p-1) D[sub, p, :] (the complex-step convective terms of
+        # element_compiled._convective need Im(rows) = Im(xi) d rows/d xi)
+        pw = xi[:, None] ** np.arange(6)[None, :]                     # (G, 6)
+        dpw = np.zeros_like(pw)
+        dpw[:, 1:] = pw[:, :-1] * np.arange(1, 6)[None, :]
+        D_q = self._D_all[sub]                                         # (G, 6, nrow)
+        self._q_rows = np.ascontiguousarray(np.stack([np.einsum("gp,gpk->gk", pw, D_q),
+                                                      np.einsum("gp,gpk->gk", dpw, D_q)], 1))
         inv = 1.0 / (n - 1)
         self._dl_dchi = np.array([-inv, inv])
 
