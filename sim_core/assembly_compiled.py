@@ -37,8 +37,16 @@ def _scatter(M, F, red, sg, idx, Me, Fe, with_mass):
                     M[ra, rb] += sa * sg[idx[b]] * Me[a, b]
 
 
+def _scatter_blocks(M, F, red, sg, IDX, Ms, Fs):
+    for e in range(IDX.shape[0]):
+        _scatter(M, F, red, sg, IDX[e], Ms[e], Fs[e], True)
+
+
 if AVAILABLE:
     _scatter_compiled = cardan_compiled.numba.njit(cache=True, nogil=True)(_scatter)
+    _scatter = _scatter_compiled                # the callee of _scatter_blocks
+    _scatter_blocks_compiled = cardan_compiled.numba.njit(cache=True, nogil=True)(
+        _scatter_blocks)
 
 
 def scatter_add(M, F, red, sg, idx, Me, Fe) -> None:
@@ -61,3 +69,14 @@ def scatter_add(M, F, red, sg, idx, Me, Fe) -> None:
 
 
 _NO_MASS = np.zeros((0, 0))
+
+
+def scatter_add_blocks(M, F, red, sg, IDX, Ms, Fs) -> bool:
+    """scatter_add of E blocks (IDX (E, k), Ms (E, k, k), Fs (E, k)) in one compiled call;
+    False (nothing added) where that does not apply (no numba, not float64 arrays)."""
+    if not (AVAILABLE and isinstance(Ms, np.ndarray) and isinstance(Fs, np.ndarray)
+            and M is not None and M.dtype == np.float64 and F.dtype == np.float64
+            and Ms.dtype == np.float64 and Fs.dtype == np.float64):
+        return False
+    _scatter_blocks_compiled(M, F, red, sg, IDX, Ms, Fs)
+    return True

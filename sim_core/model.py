@@ -19,7 +19,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from .beam import cardan_compiled, element_compiled
-from .assembly_compiled import scatter_add
+from .assembly_compiled import scatter_add, scatter_add_blocks
 from .beam.moving_node_beam import Beam
 from .constraints import constraint_terms, kkt_accelerations, kkt_factor
 from .effects import Effect, ElementContext, Gravity, PointLoad, StressFilter
@@ -290,8 +290,10 @@ class Model:
                 rest.append(pe)
         if blocks is not None:                 # the batch (started above, maybe on the worker)
             Ms, Fs = blocks()
-            for (_, idx), Me, Fe in zip(self.element_indices(), Ms, Fs):
-                put(idx, Me, Fe)
+            if Qdd_p is not None or not scatter_add_blocks(M, F, red, sg, self._element_idx,
+                                                           Ms, Fs):
+                for (_, idx), Me, Fe in zip(self.element_indices(), Ms, Fs):
+                    put(idx, Me, Fe)
         else:
             for el, idx in self.element_indices():
                 put(idx, *self.element_terms(t, el, Q[idx], Qd[idx], mass))
