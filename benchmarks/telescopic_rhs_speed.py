@@ -30,13 +30,25 @@ last evaluation, and a benchmark that repeats one state measures cache hits.  Va
 * ``+ elements on a worker thread`` and the compiled element batch on a second thread while
   the constraint rows are formed (``Model.element_thread``; the rows before run the batch on
   the calling thread),
+* ``+ GIL handed to the worker`` and the calling thread releasing the GIL once after
+  submitting the batch (``Model.element_yield``; without it the batch started ~0.27 ms late,
+  waiting for the GIL while the constraint rows ran Python),
+* ``+ points in one compiled call`` and every material point's kinematics, rigid offset and
+  full-length Jacobians in one compiled call (``constraints.POINTS_IN_ONE_CALL``),
+* ``+ friction Newton in one compiled call`` and the friction-multiplier Newton's loop
+  compiled (``Model.multiplier_newton_compiled``),
 
 All variants assemble the reduced system block by block and evaluate each material point once
 for the real and complex-step states (2026-11-24, second session; before, the full N x N mass
 matrix was formed and projected, and every point was evaluated twice; that code's own version
 of this script, run at commit f32e090, wrote ``results/telescopic_rhs_speed_f32e090.md``).
+They also share what the third session (2026-11-24) changed without a switch: the friction
+section maps in closed form, the saddle-point factor on the border columns that touch each
+block, the element convective rows from tables, the element blocks scattered in one call (the
+second session's table of this script is ``results/telescopic_rhs_speed_dc97a83.md``).
 
-then a cProfile of the last variant, grouped by what the time is spent on.  Ratios within one
+then a cProfile of the last variant without the worker thread, grouped by what the time is
+spent on.  Ratios within one
 run are what the table is for; the machine may be shared.
 
 Writes benchmarks/results/telescopic_rhs_speed.md (atomically).
@@ -56,7 +68,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..")))
 
-from sim_core import assembly_compiled                        # noqa: E402
+from sim_core import assembly_compiled, constraints           # noqa: E402
 from sim_core.beam import cardan_compiled, element_compiled, point_compiled  # noqa: E402
 from sim_core.contact import micro_motion_compiled            # noqa: E402
 from sim_core.result import atomic_write_bytes                # noqa: E402
@@ -66,22 +78,29 @@ OUT = os.path.join(os.path.dirname(__file__), "results", "telescopic_rhs_speed.m
 
 # (label, multiplier Newton, compiled: section state, micro-motion Newton, point kinematics,
 # element mass and forces, block elimination of the saddle-point system, compiled scatter,
-# the element batch on a worker thread)
-VARIANTS = (("fixed point, numpy", False, False, False, False, False, False, False, False),
-            ("Newton, numpy", True, False, False, False, False, False, False, False),
-            ("+ compiled section", True, True, False, False, False, False, False, False),
-            ("+ compiled micro-motion", True, True, True, False, False, False, False, False),
-            ("+ compiled points", True, True, True, True, False, False, False, False),
-            ("+ compiled elements", True, True, True, True, True, False, False, False),
-            ("+ block saddle-point solve", True, True, True, True, True, True, False, False),
-            ("+ compiled scatter", True, True, True, True, True, True, True, False),
-            ("+ elements on a worker thread", True, True, True, True, True, True, True, True))
+# the element batch on a worker thread, the GIL handed to the worker after submitting,
+# material points in one compiled call, the friction Newton's loop in one compiled call)
+_F, _T = False, True
+VARIANTS = (("fixed point, numpy", _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
+            ("Newton, numpy", _T, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
+            ("+ compiled section", _T, _T, _F, _F, _F, _F, _F, _F, _F, _F, _F),
+            ("+ compiled micro-motion", _T, _T, _T, _F, _F, _F, _F, _F, _F, _F, _F),
+            ("+ compiled points", _T, _T, _T, _T, _F, _F, _F, _F, _F, _F, _F),
+            ("+ compiled elements", _T, _T, _T, _T, _T, _F, _F, _F, _F, _F, _F),
+            ("+ block saddle-point solve", _T, _T, _T, _T, _T, _T, _F, _F, _F, _F, _F),
+            ("+ compiled scatter", _T, _T, _T, _T, _T, _T, _T, _F, _F, _F, _F),
+            ("+ elements on a worker thread", _T, _T, _T, _T, _T, _T, _T, _T, _F, _F, _F),
+            ("+ GIL handed to the worker", _T, _T, _T, _T, _T, _T, _T, _T, _T, _F, _F),
+            ("+ points in one compiled call", _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _F),
+            ("+ friction Newton in one compiled call", _T, _T, _T, _T, _T, _T, _T, _T, _T, _T,
+             _T))
 
 # cProfile groups: (label, "module file:function" names whose cumulative time is the group's;
 # none of them calls another group's functions)
 GROUPS = (
     ("friction (section maps, micro-motion solves, sensitivities)",
-     ("contact_friction.py:at_state", "contact_friction.py:values")),
+     ("contact_friction.py:at_state", "contact_friction.py:values",
+      "contact_friction.py:newton")),
     ("constraint rows (Jacobian, quadratic terms)", ("constraints.py:constraint_terms",)),
     ("saddle-point factorisation", ("constraints.py:kkt_factor",)),
     ("saddle-point solves", ("_decomp_lu.py:lu_solve", "constraints.py:once",
@@ -93,9 +112,13 @@ GROUPS = (
 
 
 def _configure(m, newton: bool, section: bool, micro: bool, points: bool,
-               elements: bool, blocks: bool, scatter: bool, thread: bool) -> None:
+               elements: bool, blocks: bool, scatter: bool, thread: bool, handover: bool,
+               points_one_call: bool, newton_compiled: bool) -> None:
     m.multiplier_newton = newton
     m.element_thread = thread
+    m.element_yield = handover
+    m.multiplier_newton_compiled = newton_compiled
+    constraints.POINTS_IN_ONE_CALL = points_one_call
     m.kkt_blocks = blocks
     assembly_compiled.AVAILABLE = scatter and cardan_compiled.numba is not None
     cardan_compiled.AVAILABLE = section and cardan_compiled.numba is not None
@@ -171,9 +194,11 @@ def main() -> int:
         a = times[label] * 1e3
         lines.append(f"| {label} | {a.min():.1f} | {np.median(a):.1f} | {base * 1e3 / a.min():.2f} |")
     # profiled on one thread: cProfile sees only the calling thread
-    _configure(m, *VARIANTS[-2][1:])
+    one_thread = VARIANTS[-1][1:8] + (False, False) + VARIANTS[-1][10:]
+    _configure(m, *one_thread)
     total, rows = profile_groups(m, t, y)
-    lines += ["", f"Where the time of `{VARIANTS[-2][0]}` goes (cProfile, 40 calls, one thread; "
+    lines += ["", f"Where the time of `{VARIANTS[-1][0]}` without the worker thread goes "
+              f"(cProfile, 40 calls, one thread; "
               f"the profiler adds overhead to every Python call, so shares, not times; the last "
               f"variant overlaps the elements' share with the constraint rows'):", "",
               "| part | share |", "|---|---|"]
