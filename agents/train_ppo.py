@@ -207,6 +207,11 @@ def train(timesteps: int, seed: int, out: str | os.PathLike, n_envs: int | None 
             raise SystemExit("--tensorboard needs the tensorboard package (pip install tensorboard)")
     model = PPO("MlpPolicy", venv, seed=seed, device="cpu", policy_kwargs=policy_kwargs,
                 tensorboard_log=tensorboard, verbose=verbose, **hyper)
+    if not tensorboard and verbose == 0:
+        # SB3's default logger would create an empty SB3-<time> folder in the temp directory
+        # on every learn(); nothing is logged here, so a logger without outputs is set
+        from stable_baselines3.common.logger import Logger
+        model.set_logger(Logger(folder=None, output_formats=[]))
     cbs = [_curve_callback(out / "learning_curve.csv", curve_every)]
     if checkpoint_every > 0:
         cbs.append(CheckpointCallback(save_freq=max(checkpoint_every // n_envs, 1),
