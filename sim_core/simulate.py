@@ -26,8 +26,8 @@ from .statics import static_equilibrium
 # (_bdf_newton_limit) and restores it after each.  Why: the structured Jacobian costs ~45
 # right-hand sides at the paper's discretisation, while a Newton iteration with the stale one
 # costs one, so a slower but converging iteration is cheaper than a new Jacobian.  Measured
-# on the paper's extraction run (2026-11-24): 64 -> 33 Jacobians, 41.1 -> 38.4 s, together
-# with MethodSwitch's Jacobian probe; the step sizes are still set by the error test.
+# on the paper's extraction run (2026-11-24, with MethodSwitch's Jacobian probe): 54 -> 33
+# Jacobians, 41.1 -> 38.4 s; the step sizes are still set by the error test.
 BDF_NEWTON_ITERATIONS = 8
 
 
@@ -216,11 +216,13 @@ class MethodSwitch:
     over its last ``window`` accepted steps is recorded.  BDF runs ``bdf_steps`` accepted steps,
     then hands back to RK45 (a trial: if the problem is still stiff the detector switches again
     after its 15 steps) -- unless BDF paid off and its step h is still beyond RK45's
-    stability, h rho(J) > ``stay_factor`` x 3.25 with rho(J) the spectral radius of BDF's
-    current Jacobian (:func:`spectral_radius`): then BDF goes on for a stretch twice as long
-    without the trial, which would cost ~15 stability-limited RK45 steps (90+ evaluations) to
-    learn what the Jacobian already says.  Each BDF stretch is judged against the RK45 stretch before it (cost =
-    model evaluations per simulated second, BDF's Jacobians included): when
+    stability, h rho(J) > ``stay_factor`` x 3.25 with rho(J) the spectral radius
+    (:func:`spectral_radius`) of a fresh Jacobian (``fresh_jacobian(solver)``; BDF's own may
+    be stale, it is renewed only when Newton fails): then BDF goes on with that Jacobian for a
+    stretch twice as long, without the trial, which would cost ~15 stability-limited RK45
+    steps (90+ evaluations) to learn what the Jacobian already says.  Each BDF stretch is
+    judged against the RK45 stretch before it (cost = model evaluations per simulated second,
+    BDF's Jacobians included): when
     BDF was cheaper, its next stretch is twice as long (up to ``max_bdf_steps``); when it was
     dearer (e.g. sticking friction that changes regime every few steps, so BDF recomputes its
     Jacobian almost every step), its next stretch is halved and RK45
