@@ -162,30 +162,28 @@ class ContactFriction:
         mu = np.array([r[6] for r in regions], dtype=float)
         k0, eps, kappa = self.spring.k0, self.spring.eps, _KAPPA * self.spring.k0
         nan5 = np.full(5, np.nan)
+        maps = (Lf, Lm, rp, ra, mu, A, AT, BfT, AtA, BftA, Lr)   # the kernels' shared arguments
+        law = (k0, eps, kappa, _RTOL, _MAX_ITER)
+
+        def warm(x0):                    # the regions' last micro-motions (NaN: none yet)
+            return np.stack([x0.get(nm, nan5) for nm in names]).astype(float)
 
         def values(lam, x0, gradient):
-            X0 = np.stack([x0.get(nm, nan5) for nm in names]).astype(float)
-            g, dg, X, status = mmc.regions_values(lam, Lf, Lm, rp, ra, mu, A, AT, BfT, AtA,
-                                                   BftA, Lr, X0, k0, eps, kappa, _RTOL,
-                                                   _MAX_ITER, gradient)
+            g, dg, X, status = mmc.regions_values(lam, *maps, warm(x0), *law, gradient)
             if status.any():
                 return None
-            for nm, x in zip(names, X):
-                x0[nm] = x
+            x0.update(zip(names, X))
             return g, (dg if gradient else None)
 
         def newton(lam0, L, x0, tol, max_iter):
             # the whole multiplier Newton (Model._multiplier_newton) in one compiled call; None
             # where a region needs the reference path (the caller runs the Python loop)
-            X0 = np.stack([x0.get(nm, nan5) for nm in names]).astype(float)
             g, X, ok = mmc.multiplier_newton(
                 np.ascontiguousarray(lam0, dtype=float), np.ascontiguousarray(L, dtype=float),
-                Lf, Lm, rp, ra, mu, A, AT, BfT, AtA, BftA, Lr, X0, k0, eps, kappa, _RTOL,
-                _MAX_ITER, float(tol), int(max_iter))
+                *maps, warm(x0), *law, float(tol), int(max_iter))
             if not ok:
                 return None
-            for nm, x in zip(names, X):
-                x0[nm] = x
+            x0.update(zip(names, X))
             return g
         values.newton = newton
         return values

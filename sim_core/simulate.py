@@ -46,13 +46,13 @@ class SecondOrderNewtonLU:
     def __init__(self, solver):
         self.solver = solver
         self.n = solver.n // 2
+        self.eye = np.eye(self.n)
 
     def lu(self, A):
         self.solver.nlu += 1
-        n = self.n
+        n, eye = self.n, self.eye
         if 2 * n == A.shape[0] and n > 0:
             c = -A[0, n]
-            eye = np.eye(n)
             if np.array_equal(A[:n, :n], eye) and np.array_equal(A[:n, n:], -c * eye):
                 A21 = A[n:, :n].copy()                          # -c A_z
                 S = A[n:, n:] + c * A21                         # A22 - A21 A12

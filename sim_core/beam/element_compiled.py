@@ -101,15 +101,15 @@ def _strain_arguments(RR, TT, g, x_l, x_p):
     x_p[7] = TT[g, 2]
 
 
-def _convective(qe, qde, cstep, n, q_rows, q_pos, q_sub, pow_p, pow_t, basis, i_s1,
+def _convective(qe, qde, cstep, n, q_phi, q_psi, q_drows, q_pos, pow_p, pow_t, basis, i_s1,
                 with_strain):
     """Material convective terms at the Gauss points (Model.element_context):
     a = (J_r)^. q_dot (G, 3), w_dot = (J_w)^. q_dot (G, 3), eps_ddot = (B_s)^. q_dot (G, 4)
     (zeros unless with_strain), by complex step in q along q_dot at the fixed material s.
     The basis rows at the complex xi of a Gauss point: xi = (s - s_1)/l - sub (Eq. 10) has the
-    real part of the point's table (q_rows[:, 0]) and Im xi = -(Im s_1 + chi Im l)/Re l (to
-    O(h^2), chi = sub + xi), so rows(xi) = rows + i Im(xi) d rows/d xi (q_rows[:, 1]) exactly
-    in double precision for the step h = 1e-20."""
+    real part of the point's tables (q_phi, q_psi before the powers of l) and
+    Im xi = -(Im s_1 + chi Im l)/Re l (to O(h^2), chi = sub + xi), so rows(xi) = rows +
+    i Im(xi) d rows/d xi (q_drows) exactly in double precision for the step h = 1e-20."""
     G = q_pos.shape[0]
     na = n + 4
     npos = 3 * na
@@ -130,13 +130,13 @@ def _convective(qe, qde, cstep, n, q_rows, q_pos, q_sub, pow_p, pow_t, basis, i_
         for i in range(7):
             for a in range(na):
                 k = i * na + a
-                X[g, i, a] = (q_rows[g, 0, k] + 1j * (xi_im * q_rows[g, 1, k])) \
+                X[g, i, a] = (q_phi[g, i, a] + 1j * (xi_im * q_drows[g, k])) \
                     * lpow[pow_p[i, a]]
         off = 7 * na
         for i in range(5):
             for a in range(nt):
                 k = off + i * nt + a
-                Y[g, i, a] = (q_rows[g, 0, k] + 1j * (xi_im * q_rows[g, 1, k])) \
+                Y[g, i, a] = (q_psi[g, i, a] + 1j * (xi_im * q_drows[g, k])) \
                     * lpow[pow_t[i, a]]
         frac = (q_pos[g] + 1j * xi_im) / (n - 1)
         ds[g, 0] = 1.0 - frac
@@ -208,7 +208,7 @@ def _convective(qe, qde, cstep, n, q_rows, q_pos, q_sub, pow_p, pow_t, basis, i_
     return a_out, w_out, e_out
 
 
-def _mass_force(qe, qde, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_sub, q_rows, basis,
+def _mass_force(qe, qde, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_drows, basis,
                 i_s1, rhoA, Jrot, D, h, grav, inertia, elasticity, gravity, needs_mass, cstep,
                 qdde):
     """(Me (nq, nq) or (0, 0), Fe (nq,)) of one element; see element_mass_force.  A non-empty
@@ -298,8 +298,8 @@ def _mass_force(qe, qde, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_sub,
     # per-row loads v: Fe = v . J (one matrix-vector product) + the dl/dQ energy terms
     conv = inertia or filt
     if conv:
-        acc_c, wdot_c, eddot_c = _convective(qe, qde, cstep, n, q_rows, q_pos, q_sub, pow_p,
-                                             pow_t, basis, i_s1, filt)
+        acc_c, wdot_c, eddot_c = _convective(qe, qde, cstep, n, q_phi, q_psi, q_drows, q_pos,
+                                             pow_p, pow_t, basis, i_s1, filt)
     v = np.zeros((G, K))
     Fe_extra = np.zeros(nq)
     total = 0.0
@@ -390,7 +390,7 @@ def _mass_force(qe, qde, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_sub,
     return _gram(A.reshape(G * km, nq)), Fe
 
 
-def _mass_force_batch(QE, QDE, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_sub, q_rows,
+def _mass_force_batch(QE, QDE, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_drows,
                       bases, i_s1, rhoAs, Jrots, Ds, h, grav, inertia, elasticity, gravity, cstep,
                       no_acc):
     """_mass_force of E elements with the same tables (rows of QE, QDE; per element the
@@ -400,7 +400,7 @@ def _mass_force_batch(QE, QDE, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, 
     Fs = np.empty((E, nq))
     for e in range(E):
         M, F = _compiled_mass_force(QE[e], QDE[e], n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w,
-                                    q_pos, q_sub, q_rows, bases[e], i_s1, rhoAs[e], Jrots[e],
+                                    q_pos, q_drows, bases[e], i_s1, rhoAs[e], Jrots[e],
                                     Ds[e], h, grav, inertia, elasticity, gravity, True, cstep,
                                     no_acc)
         Ms[e] = M
@@ -409,7 +409,7 @@ def _mass_force_batch(QE, QDE, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, 
 
 
 def _differences_batch(QE, QDE, QDDE, HQ, HQD, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos,
-                       q_sub, q_rows, bases, i_s1, rhoAs, Jrots, Ds, h, grav, inertia,
+                       q_drows, bases, i_s1, rhoAs, Jrots, Ds, h, grav, inertia,
                        elasticity, gravity, cstep, no_acc):
     """Forward differences of E elements (the structured Jacobian's element columns,
     sim_core.state_jacobian): per element d(F - M qdd)/dq and dF/dq_dot (nq, nq), steps HQ,
@@ -420,7 +420,7 @@ def _differences_batch(QE, QDE, QDDE, HQ, HQD, n, q_phi, q_psi, pow_p, pow_t, q_
     for e in range(E):
         qe = QE[e].copy()
         qde = QDE[e].copy()
-        args = (n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_sub, q_rows, bases[e], i_s1,
+        args = (n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_drows, bases[e], i_s1,
                 rhoAs[e], Jrots[e], Ds[e], h, grav, inertia, elasticity, gravity, False, cstep)
         R0 = _compiled_mass_force(qe, qde, *args, QDDE[e])[1]
         F0 = _compiled_mass_force(qe, qde, *args, no_acc)[1]
@@ -522,7 +522,7 @@ def element_mass_force(el, qe, qde, rhoA, Jrot, D, h=0.0, g=None, inertia=True,
         needs_mass = False
     Me, Fe = _compiled_mass_force(
         qe, qde, el.n, el._q_phi, el._q_psi, el._pow_p, el._pow_t, el._q_ds_dchi, el.q_w,
-        el._q_pos, el.q_sub, el._q_rows, el.G, el.i_s1, float(rhoA),
+        el._q_pos, el._q_drows, el.G, el.i_s1, float(rhoA),
         np.ascontiguousarray(Jrot, dtype=float), np.ascontiguousarray(D, dtype=float),
         float(h), grav, bool(inertia), bool(elasticity), bool(np.any(grav != 0.0)),
         bool(needs_mass), float(cstep),
@@ -532,8 +532,7 @@ def element_mass_force(el, qe, qde, rhoA, Jrot, D, h=0.0, g=None, inertia=True,
     return (Me if needs_mass else None), Fe
 
 
-_TABLES = ("_q_phi", "_q_psi", "_pow_p", "_pow_t", "_q_ds_dchi", "q_w", "_q_pos", "q_sub",
-           "_q_rows")
+_TABLES = ("_q_phi", "_q_psi", "_pow_p", "_pow_t", "_q_ds_dchi", "q_w", "_q_pos", "_q_drows")
 
 
 class ElementBatch:

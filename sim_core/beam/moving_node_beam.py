@@ -281,15 +281,12 @@ class SplineElement:
         Dt = np.einsum("pkm,ima->ipka", fac[:4, :3, :4], b.tor_coeffs)[:, :, kt] * self._fac_t
         Dt = np.concatenate([Dt, np.zeros((n - 1, 2) + Dt.shape[2:])], axis=1)
         self._D_all = np.concatenate([Dp.reshape(n - 1, 6, -1), Dt.reshape(n - 1, 6, -1)], 2)
-        # at the quadrature points: the rows sum_p xi^p D[sub, p, :] and their xi-derivatives
-        # sum_p p xi^(p-1) D[sub, p, :] (the complex-step convective terms of
+        # at the quadrature points: the xi-derivatives sum_p p xi^(p-1) D[sub, p, :] of the
+        # rows (the rows themselves are _q_phi, _q_psi; the complex-step convective terms of
         # element_compiled._convective need Im(rows) = Im(xi) d rows/d xi)
-        pw = xi[:, None] ** np.arange(6)[None, :]                     # (G, 6)
-        dpw = np.zeros_like(pw)
-        dpw[:, 1:] = pw[:, :-1] * np.arange(1, 6)[None, :]
-        D_q = self._D_all[sub]                                         # (G, 6, nrow)
-        self._q_rows = np.ascontiguousarray(np.stack([np.einsum("gp,gpk->gk", pw, D_q),
-                                                      np.einsum("gp,gpk->gk", dpw, D_q)], 1))
+        dpw = np.zeros((len(xi), 6))
+        dpw[:, 1:] = xi[:, None] ** np.arange(5)[None, :] * np.arange(1, 6)[None, :]
+        self._q_drows = np.ascontiguousarray(np.einsum("gp,gpk->gk", dpw, self._D_all[sub]))
         inv = 1.0 / (n - 1)
         self._dl_dchi = np.array([-inv, inv])
 

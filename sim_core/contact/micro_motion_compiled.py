@@ -208,11 +208,14 @@ def _multiplier_newton(lam0, L, Lf, Lm, rp, ra, mu, A, AT, BfT, AtA, BftA, Lr, X
     than ``tol`` relative to max(max |lambda|, 1).  The same operations in the same order as
     the Python loop.  Returns (g, X (the micro-motions to warm-start from), ok); ok False where
     a region needs the reference path (status != 0): the caller then runs the Python loop."""
+    def values(lam, X):
+        return regions_values(lam, Lf, Lm, rp, ra, mu, A, AT, BfT, AtA, BftA, Lr, X, k0, eps,
+                              kappa, rtol, max_iter_mm, True)
+
     k = L.shape[1]
     g = np.zeros(k)
     lam = lam0 + np.dot(L, g)
-    gv, dg, X, st = regions_values(lam, Lf, Lm, rp, ra, mu, A, AT, BfT, AtA, BftA, Lr, X0,
-                                   k0, eps, kappa, rtol, max_iter_mm, True)
+    gv, dg, X, st = values(lam, X0)
     if st.any():
         return g, X0, False
     r = g - gv
@@ -225,9 +228,7 @@ def _multiplier_newton(lam0, L, Lf, Lm, rp, ra, mu, A, AT, BfT, AtA, BftA, Lr, X
             g = g_new
             break
         lam_new = lam0 + np.dot(L, g_new)
-        gv_new, dg_new, Xn, st = regions_values(lam_new, Lf, Lm, rp, ra, mu, A, AT, BfT, AtA,
-                                                BftA, Lr, X, k0, eps, kappa, rtol, max_iter_mm,
-                                                True)
+        gv_new, dg_new, Xn, st = values(lam_new, X)
         if st.any():
             return g, X0, False
         X = Xn
@@ -235,9 +236,7 @@ def _multiplier_newton(lam0, L, Lf, Lm, rp, ra, mu, A, AT, BfT, AtA, BftA, Lr, X
         if np.max(np.abs(r_new)) > np.max(np.abs(r)):          # safeguard: fixed-point step
             g_new = gv.copy()
             lam_new = lam0 + np.dot(L, g_new)
-            gv_new, dg_new, Xn, st = regions_values(lam_new, Lf, Lm, rp, ra, mu, A, AT, BfT,
-                                                    AtA, BftA, Lr, X, k0, eps, kappa, rtol,
-                                                    max_iter_mm, True)
+            gv_new, dg_new, Xn, st = values(lam_new, X)
             if st.any():
                 return g, X0, False
             X = Xn

@@ -130,21 +130,23 @@ def test_uncovered_effects_rejected():
 
 @pytest.mark.parametrize("n_nodes", [3, 9])
 def test_quadrature_row_tables(n_nodes):
-    """_q_rows of an element: the basis rows at the Gauss points (the position and torsion
-    tables _q_phi, _q_psi before the powers of l) and their xi-derivatives (against central
-    differences of the rows at xi +- 1e-6 from the arbitrary-point polynomial _D_all)."""
+    """The rows of the arbitrary-point polynomial _D_all at the Gauss points are the position
+    and torsion tables _q_phi, _q_psi (the real parts the convective terms take from them), and
+    _q_drows are their xi-derivatives (against central differences at xi +- 1e-6)."""
     model, el, qe, qde, sec = _moving_element(n_nodes, _effects(ALL))
     el._basis_tables()
     na, nt = el.n + 4, 2 * el.n
-    rows, drows = el._q_rows[:, 0], el._q_rows[:, 1]
+    xi, sub = el._q_pos - el.q_sub, el.q_sub
+
+    def rows_at(x):
+        return np.einsum("gp,gpk->gk", x[:, None] ** np.arange(6), el._D_all[sub])
+    rows = rows_at(xi)
     G = rows.shape[0]
     np.testing.assert_allclose(rows[:, :7 * na].reshape(G, 7, na), el._q_phi, rtol=0,
                                atol=1e-12 * np.abs(el._q_phi).max())
     np.testing.assert_allclose(rows[:, 7 * na:7 * na + 5 * nt].reshape(G, 5, nt), el._q_psi,
                                rtol=0, atol=1e-12 * np.abs(el._q_psi).max())
     h = 1e-6
-    xi, sub = el._q_pos - el.q_sub, el.q_sub
-    up = np.einsum("gp,gpk->gk", (xi + h)[:, None] ** np.arange(6), el._D_all[sub])
-    lo = np.einsum("gp,gpk->gk", (xi - h)[:, None] ** np.arange(6), el._D_all[sub])
-    np.testing.assert_allclose(drows, (up - lo) / (2 * h), rtol=0,
+    drows = el._q_drows
+    np.testing.assert_allclose(drows, (rows_at(xi + h) - rows_at(xi - h)) / (2 * h), rtol=0,
                                atol=1e-6 * np.abs(drows).max())
