@@ -44,6 +44,9 @@ class NonlinearConstraint:
     # structured Jacobian (sim_core.state_jacobian) differentiates only those. None: unknown
     # (every coordinate is differenced)
     points: tuple | None = None
+    # (kind, components, point functions) of sim_core.constraint_compiled, set by the factories
+    # below: the rows as one compiled program (None: this constraint is evaluated in Python)
+    program: tuple | None = None
 
     def coords(self, Q: Vec) -> np.ndarray | None:
         """Coordinates g depends on at Q (None: possibly all)."""
@@ -67,6 +70,10 @@ _H = 1e-20
 # reference of the tests)
 POINTS_IN_ONE_CALL = True
 
+# the rows of constraints built by the factories below as one compiled program
+# (sim_core.constraint_compiled); False: each constraint's closure in Python (the reference)
+COMPILED_ROWS = True
+
 
 def dependencies(points, Q: Vec) -> np.ndarray | None:
     """Union of the coordinates the point functions depend on at Q; None if one of them does not
@@ -86,9 +93,16 @@ def constraint_terms(cons: list[NonlinearConstraint], t: float, Q: Vec, Qd: Vec)
     if not cons:
         e = np.zeros(0)
         return e, np.zeros((0, len(Q))), e, e
+    real = not (np.iscomplexobj(Q) or np.iscomplexobj(Qd))
+    if real and COMPILED_ROWS:
+        from . import constraint_compiled
+        prog = constraint_compiled.program_for(cons)
+        if prog is not None:
+            g, G, quad, _ = prog.terms(Q, Qd)
+            b, bd, bdd = targets(cons, t)
+            return g - b, G, G @ Qd - bd, bdd - quad
     phis, jacs, dphis, rhs = [], [], [], []
     Qc = Q + 1j * _H * Qd                  # one complex state: the point caches serve all rows
-    real = not (np.iscomplexobj(Q) or np.iscomplexobj(Qd))
     for c in cons:
         gc, Jc = c.evaluate(Qc)
         if real:    # the real parts of a complex-step evaluation are the real evaluation
@@ -102,6 +116,12 @@ def constraint_terms(cons: list[NonlinearConstraint], t: float, Q: Vec, Qd: Vec)
         dphis.append(np.real(J) @ Qd - bd)
         rhs.append(bdd - quad)
     return (np.concatenate(phis), np.vstack(jacs), np.concatenate(dphis), np.concatenate(rhs))
+
+
+def targets(cons: list[NonlinearConstraint], t: float):
+    """Stacked (b, b_dot, b_ddot) of the constraints at t."""
+    parts = [c.b(t) for c in cons]
+    return tuple(np.concatenate([p[i] for p in parts]) for i in range(3))
 
 
 def kkt_factor(Mr: Vec, C: Vec, blocks=None):
@@ -314,6 +334,7 @@ def material_point(model, ibeam: int, s_fixed: float | None = None, s_index: int
         return locate(Q)[2]
 
     f.coords = coords
+    f.spec = ("material", model, ibeam, s_fixed, s_index, o_sec)   # constraint_compiled
     cache[key] = f
     return f
 
@@ -326,6 +347,7 @@ def fixed_point(r) -> Callable:
         Z = np.zeros((3, len(Q)))
         return r, Z, np.zeros(3), Z
     f.coords = lambda Q: np.zeros(0, dtype=int)
+    f.spec = ("fixed", r)                      # constraint_compiled
     return f
 
 
@@ -345,8 +367,9 @@ def _coincidence(name: str, fa, fb, fixed, part: int) -> NonlinearConstraint:
             return a[2 * part], a[2 * part + 1]
         b = fb(Q)
         return a[2 * part] - b[2 * part], a[2 * part + 1] - b[2 * part + 1]
+    pts = (fa,) if fb is None else (fa, fb)
     return NonlinearConstraint(name, 3, evaluate, None if fixed is None else _fixed(fixed),
-                               points=(fa,) if fb is None else (fa, fb))
+                               points=pts, program=(part, (0, 1, 2), pts))
 
 
 def point_coincidence(name: str, fa, fb=None, fixed=None) -> NonlinearConstraint:
@@ -370,7 +393,8 @@ def distance_driver(name: str, fa, fb, length) -> NonlinearConstraint:
         d = ra - rb
         n = np.sqrt(d @ d)
         return np.atleast_1d(n), ((d / n) @ (Ja - Jb))[None, :]
-    return NonlinearConstraint(name, 1, evaluate, length, points=(fa, fb))
+    return NonlinearConstraint(name, 1, evaluate, length, points=(fa, fb),
+                               program=(2, (), (fa, fb)))      # constraint_compiled.DISTANCE
 
 
 def rope_length(name: str, points, length: float) -> NonlinearConstraint:
@@ -390,4 +414,5 @@ def rope_length(name: str, points, length: float) -> NonlinearConstraint:
             ell = ell + n
             J = J + (d / n) @ (Jb - Ja)
         return np.atleast_1d(ell), np.atleast_2d(J)
-    return NonlinearConstraint(name, 1, evaluate, _fixed([length]), points=tuple(points))
+    return NonlinearConstraint(name, 1, evaluate, _fixed([length]), points=tuple(points),
+                               program=(3, (), tuple(points)))  # constraint_compiled.ROPE

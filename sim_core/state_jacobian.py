@@ -32,10 +32,14 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg as sla
 
-from .constraints import constraint_terms
+from .constraint_compiled import program_for
+from .constraints import constraint_terms, targets
 
 _H = 1e-20                       # complex step of the quadratic velocity terms (as in constraints)
 REL_STEP = 1.5e-8                # ~sqrt(machine epsilon): forward-difference step per unit of |x|
+# the constraint pieces' columns in one compiled sweep (sim_core.constraint_compiled) where the
+# constraints are covered; False: column by column in Python (the reference)
+COMPILED_CONSTRAINT_COLUMNS = True
 
 
 def _steps(x: np.ndarray, rel_step: float) -> np.ndarray:
@@ -142,7 +146,18 @@ def state_jacobian(model, t: float, y: np.ndarray, rel_step: float = REL_STEP,
     # part of the complex-step Jacobian G(Q + i h Q_dot) / h
     xi1, xi2 = model.baumgarte
     row = 0
-    for c in model.nonlinear:
+    prog = None if central or not COMPILED_CONSTRAINT_COLUMNS else program_for(model.nonlinear)
+    if prog is not None:        # all constraint pieces in one compiled sweep (same differences)
+        b0, bd, bdd = targets(model.nonlinear, t)
+        deps = prog.dependencies(Q)
+        cols = np.flatnonzero(deps.any(axis=0))
+        d1, d2 = prog.columns(Q, Qd, Qdd, lam, b0, bd, bdd, xi1, xi2, cols,
+                              _steps(Q[cols], rel_step))
+        dR1[:, cols] += d1
+        dR2[:, cols] += d2
+        _, G, _, G_rate = prog.terms(Q, Qd, rate_part=True)     # d/dQ_dot as below
+        dR2[:, N:] += 2.0 * G_rate + 2.0 * xi1 * G
+    for c in ([] if prog is not None else model.nonlinear):
         sl = slice(row, row + c.m)
         row += c.m
         b0, bd, bdd = c.b(t)

@@ -259,8 +259,10 @@ def _rows(c: NonlinearConstraint, keep: list[int]) -> NonlinearConstraint:
     def target(t):
         b, bd, bdd = tgt(t)
         return b[keep], bd[keep], bdd[keep]
+    prog = None if c.program is None else (c.program[0], tuple(c.program[1][i] for i in keep),
+                                           c.program[2])
     return NonlinearConstraint(c.name, len(keep), evaluate, None if tgt is None else target,
-                               points=c.points)
+                               points=c.points, program=prog)
 
 
 def initial_equilibrium(ts: TelescopicSystem, t: float = 0.0):
