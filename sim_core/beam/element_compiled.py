@@ -23,8 +23,13 @@ coordinates).  This is the same algebra as one compiled pass over the quadrature
   the second seed (Eq. 53): M += (h^2/6) int B_s^T D B_s ds, F -= int B_s^T D ((h/2) eps_dot +
   (h^2/6) (B_s)^. q_dot) ds; gravity F += int rhoA J_r^T g ds.
 
-The mass matrix is one BLAS product A^T A of the weighted Jacobian rows of all points stacked
-into a (G k, n_coords) matrix (k = 6 for inertia, + 4 for the filter), the force one
+With inertia or the filter the kinematics are evaluated once, at the complex-step state: the
+real parts are the real kinematics (to O(h^2) = 1e-40 relative), so no separate real pass is
+made.  The mass matrix is one BLAS product A^T A of the weighted Jacobian rows J_w and B_s of
+all points stacked into a (G k, n_coords) matrix (k = 3 for the rotary inertia, + 4 for the
+filter) plus the translational part sum w rhoA J_r^T J_r formed in its Kronecker structure
+(J_r = X_0 (x) I_3 on the position coefficients: a (n+4) x (n+4) sum instead of 3 rows per
+point in the product; 880 -> 670 us per telescopic batch of 6 elements); the force one
 matrix-vector product of the stacked unweighted rows (J_r, J_w, B_s) with the per-row loads.
 
 The numpy path (``Model.element_mass_force``) stays the reference and the fallback where numba
@@ -101,11 +106,12 @@ def _strain_arguments(RR, TT, g, x_l, x_p):
     x_p[7] = TT[g, 2]
 
 
-def _convective(qe, qde, cstep, n, q_phi, q_psi, q_drows, q_pos, pow_p, pow_t, basis, i_s1,
-                with_strain):
-    """Material convective terms at the Gauss points (Model.element_context):
-    a = (J_r)^. q_dot (G, 3), w_dot = (J_w)^. q_dot (G, 3), eps_ddot = (B_s)^. q_dot (G, 4)
-    (zeros unless with_strain), by complex step in q along q_dot at the fixed material s.
+def _complex_kinematics(qe, qde, cstep, n, q_phi, q_psi, q_drows, q_pos, pow_p, pow_t, basis,
+                        i_s1):
+    """The Gauss-point kinematics at the complex-step state qe + i h qde at the fixed material
+    s (Model.element_context): (X, Y, ds, RR, TT, eps, d, dpsi, tmat), complex; their real
+    parts are the real kinematics (to O(h^2) = 1e-40 relative), their imaginary parts / h the
+    rates the convective terms need (_convective_rates).
     The basis rows at the complex xi of a Gauss point: xi = (s - s_1)/l - sub (Eq. 10) has the
     real part of the point's tables (q_phi, q_psi before the powers of l) and
     Im xi = -(Im s_1 + chi Im l)/Re l (to O(h^2), chi = sub + xi), so rows(xi) = rows +
@@ -142,6 +148,17 @@ def _convective(qe, qde, cstep, n, q_phi, q_psi, q_drows, q_pos, pow_p, pow_t, b
         ds[g, 0] = 1.0 - frac
         ds[g, 1] = frac
     RR, TT, eps, d, dpsi, tmat = _centre_line(qc, X, Y, n, basis)
+    return X, Y, ds, RR, TT, eps, d, dpsi, tmat
+
+
+def _convective_rates(qde, cstep, n, X, Y, ds, RR, TT, eps, d, dpsi, tmat, i_s1, with_strain):
+    """Material convective terms at the Gauss points from _complex_kinematics:
+    a = (J_r)^. q_dot (G, 3), w_dot = (J_w)^. q_dot (G, 3), eps_ddot = (B_s)^. q_dot (G, 4)
+    (zeros unless with_strain), by complex step in q along q_dot at the fixed material s."""
+    G = X.shape[0]
+    na = n + 4
+    npos = 3 * na
+    nt = 2 * n
     dl0 = -1.0 / (n - 1)
     dl1 = 1.0 / (n - 1)
     qs0 = qde[i_s1]
@@ -208,6 +225,7 @@ def _convective(qe, qde, cstep, n, q_phi, q_psi, q_drows, q_pos, pow_p, pow_t, b
     return a_out, w_out, e_out
 
 
+
 def _mass_force(qe, qde, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_drows, basis,
                 i_s1, rhoA, Jrot, D, h, grav, inertia, elasticity, gravity, needs_mass, cstep,
                 qdde):
@@ -232,7 +250,19 @@ def _mass_force(qe, qde, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_drow
         for i in range(5):
             for a in range(nt):
                 Y[g, i, a] = q_psi[g, i, a] * lpow[pow_t[i, a]]
-    RR, TT, eps, d, dpsi, tmat = _centre_line(qe, X, Y, n, basis)
+    conv = inertia or filt
+    if conv:
+        # one complex pass: its real parts are the real kinematics (no second, real pass)
+        cx = _complex_kinematics(qe, qde, cstep, n, q_phi, q_psi, q_drows, q_pos, pow_p, pow_t,
+                                 basis, i_s1)
+        RR = np.ascontiguousarray(cx[3].real)
+        TT = np.ascontiguousarray(cx[4].real)
+        eps = np.ascontiguousarray(cx[5].real)
+        d = np.ascontiguousarray(cx[6].real)
+        dpsi = np.ascontiguousarray(cx[7].real)
+        tmat = np.ascontiguousarray(cx[8].real)
+    else:
+        RR, TT, eps, d, dpsi, tmat = _centre_line(qe, X, Y, n, basis)
     dl = np.empty(2)
     dl[0] = -1.0 / (n - 1)
     dl[1] = 1.0 / (n - 1)
@@ -296,10 +326,10 @@ def _mass_force(qe, qde, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_drow
                     J[g, 6 + r, i_s1 + c] = cl * dl[c] - cp_ds[g, r, c]
 
     # per-row loads v: Fe = v . J (one matrix-vector product) + the dl/dQ energy terms
-    conv = inertia or filt
     if conv:
-        acc_c, wdot_c, eddot_c = _convective(qe, qde, cstep, n, q_phi, q_psi, q_drows, q_pos,
-                                             pow_p, pow_t, basis, i_s1, filt)
+        acc_c, wdot_c, eddot_c = _convective_rates(qde, cstep, n, cx[0], cx[1], cx[2], cx[3],
+                                                   cx[4], cx[5], cx[6], cx[7], cx[8], i_s1,
+                                                   filt)
     v = np.zeros((G, K))
     Fe_extra = np.zeros(nq)
     total = 0.0
@@ -364,13 +394,15 @@ def _mass_force(qe, qde, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_drow
             return np.zeros((nq, nq)), Fe
         return np.zeros((0, 0)), Fe
     # mass: Me = A^T A with the weighted rows sqrt(w c) J of all points (one BLAS product); rows
-    # of a zero constant c (e.g. J_t = J_b = 0) are left out
+    # of a zero constant c (e.g. J_t = J_b = 0) are left out.  The translational rows J_r are
+    # X_0 (x) I_3 on the position coefficients (and two s columns): their sum is formed in that
+    # structure (_add_translational_mass), not in the product
     sel = np.empty(10, dtype=np.int64)
     cm = np.empty(10)
     km = 0
     if inertia:
-        for i in range(6):
-            c = rhoA if i < 3 else Jrot[i - 3]
+        for i in range(3, 6):
+            c = Jrot[i - 3]
             if c != 0.0:
                 sel[km] = i
                 cm[km] = c
@@ -387,7 +419,49 @@ def _mass_force(qe, qde, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_drow
             wi = np.sqrt(wl[g] * cm[i])
             for k in range(nq):
                 A[g, i, k] = J[g, sel[i], k] * wi
-    return _gram(A.reshape(G * km, nq)), Fe
+    Me = _gram(A.reshape(G * km, nq))
+    if inertia and rhoA != 0.0:
+        _add_translational_mass(Me, J, X, wl, rhoA, na, i_s1)
+    return Me, Fe
+
+
+def _add_translational_mass(Me, J, X, wl, rhoA, na, i_s1):
+    """Me += sum_g w_g rhoA J_r^T J_r, with J_r = X_0 (x) I_3 on the position coefficients
+    (J[g, j, 3 a + j] = X[g, 0, a]) and the s columns J[g, j, i_s1 + c]: the (na, na) sum
+    sum_g w rhoA X_0 X_0^T on the diagonal of every 3 x 3 block, the position-s and s-s
+    couplings from the s columns (the same sums as the product, grouped)."""
+    G = X.shape[0]
+    K0 = np.zeros((na, na))
+    Ks = np.zeros((na, 3, 2))
+    Kss = np.zeros((2, 2))
+    for g in range(G):
+        c = wl[g] * rhoA
+        for a in range(na):
+            xa = c * X[g, 0, a]
+            for b in range(na):
+                K0[a, b] += xa * X[g, 0, b]
+            for j in range(3):
+                for cc in range(2):
+                    Ks[a, j, cc] += xa * J[g, j, i_s1 + cc]
+        for cc in range(2):
+            for dd in range(2):
+                acc = 0.0
+                for j in range(3):
+                    acc += J[g, j, i_s1 + cc] * J[g, j, i_s1 + dd]
+                Kss[cc, dd] += c * acc
+    for a in range(na):
+        for b in range(na):
+            v = K0[a, b]
+            for j in range(3):
+                Me[3 * a + j, 3 * b + j] += v
+        for j in range(3):
+            for cc in range(2):
+                v = Ks[a, j, cc]
+                Me[3 * a + j, i_s1 + cc] += v
+                Me[i_s1 + cc, 3 * a + j] += v
+    for cc in range(2):
+        for dd in range(2):
+            Me[i_s1 + cc, i_s1 + dd] += Kss[cc, dd]
 
 
 def _mass_force_batch(QE, QDE, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_drows,
@@ -487,8 +561,10 @@ if AVAILABLE:
     _jit = cardan_compiled.numba.njit(cache=True, nogil=True)
     _strain_arguments = _jit(_strain_arguments)
     _centre_line = _jit(_centre_line)
-    _convective = _jit(_convective)
+    _complex_kinematics = _jit(_complex_kinematics)
+    _convective_rates = _jit(_convective_rates)
     _gram = _jit(_gram_syrk if _SYRK else _gram_dot)
+    _add_translational_mass = _jit(_add_translational_mass)
     _compiled_mass_force = _jit(_mass_force)
     _compiled_mass_force_batch = _jit(_mass_force_batch)
     _compiled_differences_batch = _jit(_differences_batch)

@@ -283,7 +283,7 @@ class SplineElement:
         self._D_all = np.concatenate([Dp.reshape(n - 1, 6, -1), Dt.reshape(n - 1, 6, -1)], 2)
         # at the quadrature points: the xi-derivatives sum_p p xi^(p-1) D[sub, p, :] of the
         # rows (the rows themselves are _q_phi, _q_psi; the complex-step convective terms of
-        # element_compiled._convective need Im(rows) = Im(xi) d rows/d xi)
+        # element_compiled._complex_kinematics need Im(rows) = Im(xi) d rows/d xi)
         dpw = np.zeros((len(xi), 6))
         dpw[:, 1:] = xi[:, None] ** np.arange(5)[None, :] * np.arange(1, 6)[None, :]
         self._q_drows = np.ascontiguousarray(np.einsum("gp,gpk->gk", dpw, self._D_all[sub]))
