@@ -175,12 +175,13 @@ class ContactFriction:
             x0.update(zip(names, X))
             return g, (dg if gradient else None)
 
-        def newton(lam0, L, x0, tol, max_iter):
-            # the whole multiplier Newton (Model._multiplier_newton) in one compiled call; None
-            # where a region needs the reference path (the caller runs the Python loop)
+        def newton(lam0, L, x0, tol, max_iter, g0):
+            # the whole multiplier Newton (Model._multiplier_newton) in one compiled call, from
+            # g0; None where a region needs the reference path (the caller runs the Python loop)
             g, X, ok = mmc.multiplier_newton(
                 np.ascontiguousarray(lam0, dtype=float), np.ascontiguousarray(L, dtype=float),
-                *maps, warm(x0), *law, float(tol), int(max_iter))
+                *maps, warm(x0), *law, float(tol), int(max_iter),
+                np.ascontiguousarray(g0, dtype=float))
             if not ok:
                 return None
             x0.update(zip(names, X))
@@ -253,13 +254,15 @@ class FrictionAtState:
                           for (_, _, _, _, _, _, mu, geom) in self.regions]
         return self._mats
 
-    def newton(self, lam0, L, tol: float, max_iter: int):
+    def newton(self, lam0, L, tol: float, max_iter: int, g0=None):
         """g solving g = g(lam0 + L g) by the multiplier Newton of Model._multiplier_newton
-        in one compiled call (micro_motion_compiled.multiplier_newton), or None where it does
-        not apply (no compiled batch, a region that needs the reference path)."""
+        in one compiled call (micro_motion_compiled.multiplier_newton) from g0 (default 0), or
+        None where it does not apply (no compiled batch, a region that needs the reference
+        path)."""
         if self._batch is None:
             return None
-        return self._batch.newton(lam0, L, self.owner._x0, tol, max_iter)
+        g0 = np.zeros(L.shape[1]) if g0 is None else g0
+        return self._batch.newton(lam0, L, self.owner._x0, tol, max_iter, g0)
 
     def solve_regions(self, lam):
         out = []

@@ -200,20 +200,21 @@ def _regions_values(lam, Lf, Lm, rp, ra, mu, A, AT, BfT, AtA, BftA, Lr, X0, k0, 
 
 
 def _multiplier_newton(lam0, L, Lf, Lm, rp, ra, mu, A, AT, BfT, AtA, BftA, Lr, X0, k0, eps,
-                       kappa, rtol, max_iter_mm, tol, max_iter):
+                       kappa, rtol, max_iter_mm, tol, max_iter, g0):
     """The friction-multiplier Newton of ``sim_core.model.Model._multiplier_newton`` in one
     compiled call, for one multiplier force whose regions all take :func:`regions_values`:
     r(g) = g - g(lam0 + L g) = 0 by Newton with the matrix I - (dg/dlam) L, the fixed-point
     step where a Newton step does not reduce max |r|, stop when a step changes lambda by less
     than ``tol`` relative to max(max |lambda|, 1).  The same operations in the same order as
-    the Python loop.  Returns (g, X (the micro-motions to warm-start from), ok); ok False where
-    a region needs the reference path (status != 0): the caller then runs the Python loop."""
+    the Python loop, from g = g0 (the caller's warm start).  Returns (g, X (the micro-motions
+    to warm-start from), ok); ok False where a region needs the reference path (status != 0):
+    the caller then runs the Python loop."""
     def values(lam, X):
         return regions_values(lam, Lf, Lm, rp, ra, mu, A, AT, BfT, AtA, BftA, Lr, X, k0, eps,
                               kappa, rtol, max_iter_mm, True)
 
     k = L.shape[1]
-    g = np.zeros(k)
+    g = g0.copy()
     lam = lam0 + np.dot(L, g)
     gv, dg, X, st = values(lam, X0)
     if st.any():

@@ -239,6 +239,7 @@ def test_compiled_multiplier_newton_equals_the_python_loop(systems, v):
     fr = m.multiplier_forces[0]
     m.accelerations_and_multipliers(0.0, z, zd)          # warm starts at this state
     x0 = {k: x.copy() for k, x in fr._x0.items()}
+    g_warm = m._g_warm
     calls = []
     newton = type(m.multiplier_forces[0].at_state(0.0, Q, Qd)).newton
 
@@ -251,6 +252,7 @@ def test_compiled_multiplier_newton_equals_the_python_loop(systems, v):
         a, lam = m.accelerations_and_multipliers(0.0, z, zd)
         fr._x0.clear()
         fr._x0.update(x0)
+        m._g_warm = g_warm                               # and the same multiplier start
         m.multiplier_newton_compiled = False
         a_ref, lam_ref = m.accelerations_and_multipliers(0.0, z, zd)
     finally:
@@ -259,3 +261,45 @@ def test_compiled_multiplier_newton_equals_the_python_loop(systems, v):
     assert calls == [True]                               # the compiled path was taken
     np.testing.assert_allclose(lam, lam_ref, rtol=0, atol=1e-12 * np.max(np.abs(lam_ref)))
     np.testing.assert_allclose(a, a_ref, rtol=0, atol=1e-12 * np.max(np.abs(a_ref)))
+
+
+@pytest.mark.parametrize("compiled", [True, False])
+def test_multiplier_newton_warm_start(systems, compiled):
+    """The multiplier Newton warm-started from the last solution (Model.multiplier_warm_start)
+    gives the cold start's solution to within its stopping rule (a last step below
+    multiplier_tol relative to max |lambda|; the Newton's error after that step is of the order
+    of its square, so 10 x multiplier_tol is a safe bound), and at a nearby state (a stage of a
+    step: the velocities 1e-3 relative apart) it needs fewer friction evaluations than from 0."""
+    ts_f, _, z = systems
+    m = ts_f.model
+    Q, Qd = _sliding_state(ts_f, z, 0.2)
+    zd = m.reduced_state(0.0, Q, Qd)[1]
+    calls = []
+    cls = type(m.multiplier_forces[0].at_state(0.0, Q, Qd))
+    values = cls.values
+
+    def counted(self, *a, **k):
+        calls.append(1)
+        return values(self, *a, **k)
+    m.multiplier_newton_compiled = compiled
+    try:
+        cls.values = counted
+        m.accelerations_and_multipliers(0.0, z, zd)           # the warm start at this state
+        zd2 = zd * (1 + 1e-3)
+        m.multiplier_warm_start = False
+        calls.clear()
+        a0, lam0 = m.accelerations_and_multipliers(0.0, z, zd2)
+        n_cold = len(calls)
+        m.accelerations_and_multipliers(0.0, z, zd)
+        m.multiplier_warm_start = True
+        calls.clear()
+        a1, lam1 = m.accelerations_and_multipliers(0.0, z, zd2)
+        n_warm = len(calls)
+    finally:
+        cls.values = values
+        m.multiplier_newton_compiled = True
+        m.multiplier_warm_start = True
+    scale = np.max(np.abs(lam0))
+    np.testing.assert_allclose(lam1, lam0, rtol=0, atol=10 * m.multiplier_tol * scale)
+    if not compiled:            # the compiled loop evaluates the forces inside one call
+        assert n_warm < n_cold, (n_warm, n_cold)
