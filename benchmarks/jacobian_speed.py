@@ -83,6 +83,7 @@ def row(n_nodes: int):
     m, t, y = sliding_state(n_nodes)
     n = m.n_dof
     t_rhs, _ = _best(lambda: m.rhs(t, y), 5)
+    state_jacobian(m, t, y)             # warm-up: compiled kernels loaded from numba's cache
     t_struct, (J, cost) = _best(lambda: state_jacobian(m, t, y, return_cost=True), 3)
     t_whole, Jw = _best(lambda: whole_rhs_jacobian(m, t, y), 1 if n_nodes >= 9 else 3)
     diff = np.linalg.norm(J[n:] - Jw[n:]) / np.linalg.norm(Jw[n:])

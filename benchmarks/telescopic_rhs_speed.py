@@ -37,6 +37,10 @@ last evaluation, and a benchmark that repeats one state measures cache hits.  Va
   full-length Jacobians in one compiled call (``constraints.POINTS_IN_ONE_CALL``),
 * ``+ friction Newton in one compiled call`` and the friction-multiplier Newton's loop
   compiled (``Model.multiplier_newton_compiled``),
+* ``+ constraint rows in one compiled program`` and the constraint rows of all constraints
+  in one compiled call (``constraints.COMPILED_ROWS``, ``sim_core.constraint_compiled``),
+* ``+ friction Newton warm-started`` and the friction-multiplier Newton started from the last
+  solution (``Model.multiplier_warm_start``; before: from zero friction),
 
 All variants assemble the reduced system block by block and evaluate each material point once
 for the real and complex-step states (2026-11-24, second session; before, the full N x N mass
@@ -45,7 +49,10 @@ of this script, run at commit f32e090, wrote ``results/telescopic_rhs_speed_f32e
 They also share what the third session (2026-11-24) changed without a switch: the friction
 section maps in closed form, the saddle-point factor on the border columns that touch each
 block, the element convective rows from tables, the element blocks scattered in one call (the
-second session's table of this script is ``results/telescopic_rhs_speed_dc97a83.md``).
+second session's table of this script is ``results/telescopic_rhs_speed_dc97a83.md``), and
+what the fourth changed in the element kernel without a switch: the kinematics once at the
+complex-step state, the translational mass in its Kronecker structure (the third session's
+table is ``results/telescopic_rhs_speed_af1e8ab.md``).
 
 then a cProfile of the last variant without the worker thread, grouped by what the time is
 spent on.  Ratios within one
@@ -79,21 +86,26 @@ OUT = os.path.join(os.path.dirname(__file__), "results", "telescopic_rhs_speed.m
 # (label, multiplier Newton, compiled: section state, micro-motion Newton, point kinematics,
 # element mass and forces, block elimination of the saddle-point system, compiled scatter,
 # the element batch on a worker thread, the GIL handed to the worker after submitting,
-# material points in one compiled call, the friction Newton's loop in one compiled call)
+# material points in one compiled call, the friction Newton's loop in one compiled call, the
+# constraint rows as one compiled program, the friction Newton warm-started)
 _F, _T = False, True
-VARIANTS = (("fixed point, numpy", _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
-            ("Newton, numpy", _T, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
-            ("+ compiled section", _T, _T, _F, _F, _F, _F, _F, _F, _F, _F, _F),
-            ("+ compiled micro-motion", _T, _T, _T, _F, _F, _F, _F, _F, _F, _F, _F),
-            ("+ compiled points", _T, _T, _T, _T, _F, _F, _F, _F, _F, _F, _F),
-            ("+ compiled elements", _T, _T, _T, _T, _T, _F, _F, _F, _F, _F, _F),
-            ("+ block saddle-point solve", _T, _T, _T, _T, _T, _T, _F, _F, _F, _F, _F),
-            ("+ compiled scatter", _T, _T, _T, _T, _T, _T, _T, _F, _F, _F, _F),
-            ("+ elements on a worker thread", _T, _T, _T, _T, _T, _T, _T, _T, _F, _F, _F),
-            ("+ GIL handed to the worker", _T, _T, _T, _T, _T, _T, _T, _T, _T, _F, _F),
-            ("+ points in one compiled call", _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _F),
-            ("+ friction Newton in one compiled call", _T, _T, _T, _T, _T, _T, _T, _T, _T, _T,
-             _T))
+VARIANTS = (
+    ("fixed point, numpy", _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
+    ("Newton, numpy", _T, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
+    ("+ compiled section", _T, _T, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
+    ("+ compiled micro-motion", _T, _T, _T, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
+    ("+ compiled points", _T, _T, _T, _T, _F, _F, _F, _F, _F, _F, _F, _F, _F),
+    ("+ compiled elements", _T, _T, _T, _T, _T, _F, _F, _F, _F, _F, _F, _F, _F),
+    ("+ block saddle-point solve", _T, _T, _T, _T, _T, _T, _F, _F, _F, _F, _F, _F, _F),
+    ("+ compiled scatter", _T, _T, _T, _T, _T, _T, _T, _F, _F, _F, _F, _F, _F),
+    ("+ elements on a worker thread", _T, _T, _T, _T, _T, _T, _T, _T, _F, _F, _F, _F, _F),
+    ("+ GIL handed to the worker", _T, _T, _T, _T, _T, _T, _T, _T, _T, _F, _F, _F, _F),
+    ("+ points in one compiled call", _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _F, _F, _F),
+    ("+ friction Newton in one compiled call", _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _F, _F),
+    ("+ constraint rows in one compiled program",
+     _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _F),
+    ("+ friction Newton warm-started", _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T),
+)
 
 # cProfile groups: (label, "module file:function" names whose cumulative time is the group's;
 # none of them calls another group's functions)
@@ -113,8 +125,11 @@ GROUPS = (
 
 def _configure(m, newton: bool, section: bool, micro: bool, points: bool,
                elements: bool, blocks: bool, scatter: bool, thread: bool, handover: bool,
-               points_one_call: bool, newton_compiled: bool) -> None:
+               points_one_call: bool, newton_compiled: bool, rows_compiled: bool,
+               warm_start: bool) -> None:
     m.multiplier_newton = newton
+    m.multiplier_warm_start = warm_start
+    constraints.COMPILED_ROWS = rows_compiled
     m.element_thread = thread
     m.element_yield = handover
     m.multiplier_newton_compiled = newton_compiled
@@ -194,7 +209,7 @@ def main() -> int:
         a = times[label] * 1e3
         lines.append(f"| {label} | {a.min():.1f} | {np.median(a):.1f} | {base * 1e3 / a.min():.2f} |")
     # profiled on one thread: cProfile sees only the calling thread
-    one_thread = VARIANTS[-1][1:8] + (False, False) + VARIANTS[-1][10:]
+    one_thread = VARIANTS[-1][1:8] + (False, False) + VARIANTS[-1][10:]   # no worker
     _configure(m, *one_thread)
     total, rows = profile_groups(m, t, y)
     lines += ["", f"Where the time of `{VARIANTS[-1][0]}` without the worker thread goes "

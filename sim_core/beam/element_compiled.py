@@ -118,7 +118,6 @@ def _complex_kinematics(qe, qde, cstep, n, q_phi, q_psi, q_drows, q_pos, pow_p, 
     i Im(xi) d rows/d xi (q_drows) exactly in double precision for the step h = 1e-20."""
     G = q_pos.shape[0]
     na = n + 4
-    npos = 3 * na
     nt = 2 * n
     nq = qe.shape[0]
     qc = np.empty(nq, dtype=np.complex128)
