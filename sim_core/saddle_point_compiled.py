@@ -1,4 +1,4 @@
-"""Compiled (numba) block elimination of the saddle-point system over the beams.
+"""Compiled (numba) block elimination of the saddle-point system over diagonal blocks of M_r.
 
 The same algorithm as :func:`sim_core.constraints._kkt_factor_blocks` (the reference and the
 fallback): Cholesky of each beam block A_i = M_r[b_i, b_i], B_i = [M_r[b_i, r], C[:, b_i]^T],

@@ -78,13 +78,20 @@ def _residual(K, Fr, c, sol):
 
 
 def test_block_elimination_matches_the_whole_lu(state):
-    """The beams are uncoupled blocks of M_r (one per beam; the payload sits on one beam).
-    Block elimination with one refinement step solves the saddle-point system to the residual
-    of the whole matrix's LU; for several right-hand sides at once too."""
+    """The elements' own coordinates (those of no other element: Model._block_of) are
+    uncoupled blocks of M_r, one per element (the payload's mass sits on one element's
+    coordinates and the shared ones): exactly zero between two blocks.  Block elimination with
+    one refinement step solves the saddle-point system to the residual of the whole matrix's
+    LU; for several right-hand sides at once too."""
     ts, z, zd = state
     m = ts.model
     Mr, Fr, C, c, blocks, K = _saddle(m, z, zd)
-    assert blocks is not None and len(blocks) == len(m.beams)
+    n_el = sum(len(b.elements) for b in m.beams)
+    assert blocks is not None and len(blocks) == n_el
+    for i, bi in enumerate(blocks):
+        assert np.abs(Mr[np.ix_(bi, bi)]).max() > 0
+        for bj in blocks[i + 1:]:
+            assert not np.any(Mr[np.ix_(bi, bj)])
     lu = kkt_factor(Mr, C)
     blk = kkt_factor(Mr, C, blocks)
     r_lu = _residual(K, Fr, c, lu(Fr, c))
@@ -347,3 +354,34 @@ def test_point_in_one_compiled_call_equals_the_reference(state, kind, monkeypatc
         assert np.iscomplexobj(a[1]) == np.iscomplexobj(X)
         for u, v in zip(a, b):
             np.testing.assert_allclose(u, v, rtol=1e-13, atol=1e-13 * max(np.max(np.abs(v)), 1))
+
+
+def test_a_point_mass_across_two_elements_takes_the_whole_matrix(state):
+    """A point effect whose mass couples the own coordinates of two elements breaks the block
+    structure: _reduced_mass_force_at then reports no blocks (the whole LU solves); on one
+    element's coordinates (and shared ones) the blocks stay."""
+    ts, z, zd = state
+    m = ts.model
+    owner = m._block_of()
+    a = int(np.flatnonzero(owner == 0)[0])
+    b = int(np.flatnonzero(owner == 1)[0])
+    shared = int(np.flatnonzero(owner == -1)[0])
+
+    class Lumped:
+        def __init__(self, idx):
+            self.idx = np.array(idx)
+
+        def local(self, t, Q, Qd, mass=True):
+            k = len(self.idx)
+            return self.idx, (np.eye(k) if mass else None), np.zeros(k)
+
+    t = 0.3
+    Q, Qd = m.full_state(t, z, zd)
+    Qdd_p = m.A_pinv @ m._b(t, 2)
+    for idx, whole in (([a, b], True), ([a, shared], False)):
+        m.point_effects.append(Lumped(idx))
+        try:
+            _, _, blocks = m._reduced_mass_force_at(t, Q, Qd, Qdd_p, blocks=True)
+        finally:
+            m.point_effects.pop()
+        assert (blocks is None) == whole, idx
