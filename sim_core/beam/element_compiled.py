@@ -275,20 +275,20 @@ def _mass_force(qe, qde, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_drow
     for g in range(G):
         wl[g] = q_w[g] * ell
 
-    # stacked rows per point: J_r (0:3), J_w (3:6), B_s (6:10)
-    K = 10 if strains else 6
-    J = np.zeros((G, K, nq))
+    # rows per point: J_r in its structure (X_0 (x) I_3 on the position coefficients, Jrs on
+    # the s_1, s_n columns), the stacked rows Jm: J_w (0:3), B_s (3:7)
+    K = 7 if strains else 3
+    Jm = np.zeros((G, K, nq))
+    Jrs = np.empty((G, 3, 2))
     cp_ds = np.zeros((G, 4, 2))          # B_xi - B_s on the s_1, s_n columns: eps' ds/dchi
     chi = np.empty((3, 2))
     A3 = np.empty((3, 3))
     x_l = np.empty(8)
     x_p = np.empty(8)
     for g in range(G):
-        for j in range(3):                                            # J_r
-            for a in range(na):
-                J[g, j, 3 * a + j] = X[g, 0, a]
+        for j in range(3):                                            # J_r, s columns
             for c in range(2):
-                J[g, j, i_s1 + c] = RR[g, 4, j] * dl[c] - RR[g, 1, j] * q_ds[g, c]
+                Jrs[g, j, c] = RR[g, 4, j] * dl[c] - RR[g, 1, j] * q_ds[g, c]
         for i in range(2):                                            # d(alpha, beta)/dchi|_s
             c_l = (dpsi[g, i, 0] * RR[g, 5, 0] + dpsi[g, i, 1] * RR[g, 5, 1]
                    + dpsi[g, i, 2] * RR[g, 5, 2])
@@ -303,14 +303,14 @@ def _mass_force(qe, qde, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_drow
                 A3[i, j] = tmat[g, i, 0] * dpsi[g, 0, j] + tmat[g, i, 1] * dpsi[g, 1, j]
             for a in range(na):
                 x1 = X[g, 1, a]
-                J[g, 3 + i, 3 * a] = A3[i, 0] * x1
-                J[g, 3 + i, 3 * a + 1] = A3[i, 1] * x1
-                J[g, 3 + i, 3 * a + 2] = A3[i, 2] * x1
+                Jm[g, i, 3 * a] = A3[i, 0] * x1
+                Jm[g, i, 3 * a + 1] = A3[i, 1] * x1
+                Jm[g, i, 3 * a + 2] = A3[i, 2] * x1
             for a in range(nt):
-                J[g, 3 + i, npos + a] = tmat[g, i, 2] * Y[g, 0, a]
+                Jm[g, i, npos + a] = tmat[g, i, 2] * Y[g, 0, a]
             for c in range(2):
-                J[g, 3 + i, i_s1 + c] = (tmat[g, i, 0] * chi[0, c] + tmat[g, i, 1] * chi[1, c]
-                                         + tmat[g, i, 2] * chi[2, c])
+                Jm[g, i, i_s1 + c] = (tmat[g, i, 0] * chi[0, c] + tmat[g, i, 1] * chi[1, c]
+                                      + tmat[g, i, 2] * chi[2, c])
         if strains:                                                   # B_s
             _strain_arguments(RR, TT, g, x_l, x_p)
             for r in range(4):
@@ -318,9 +318,9 @@ def _mass_force(qe, qde, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_drow
                     x1 = X[g, 1, a]
                     x2 = X[g, 2, a]
                     for j in range(3):
-                        J[g, 6 + r, 3 * a + j] = d[g, r, j] * x1 + d[g, r, 3 + j] * x2
+                        Jm[g, 3 + r, 3 * a + j] = d[g, r, j] * x1 + d[g, r, 3 + j] * x2
                 for a in range(nt):
-                    J[g, 6 + r, npos + a] = d[g, r, 6] * Y[g, 0, a] + d[g, r, 7] * Y[g, 1, a]
+                    Jm[g, 3 + r, npos + a] = d[g, r, 6] * Y[g, 0, a] + d[g, r, 7] * Y[g, 1, a]
                 cl = 0.0
                 cp = 0.0
                 for k in range(8):
@@ -328,14 +328,22 @@ def _mass_force(qe, qde, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_drow
                     cp += d[g, r, k] * x_p[k]
                 for c in range(2):
                     cp_ds[g, r, c] = cp * q_ds[g, c]
-                    J[g, 6 + r, i_s1 + c] = cl * dl[c] - cp_ds[g, r, c]
+                    Jm[g, 3 + r, i_s1 + c] = cl * dl[c] - cp_ds[g, r, c]
 
-    # per-row loads v: Fe = v . J (one matrix-vector product) + the dl/dQ energy terms
+    # per-row loads vr (J_r), vm (Jm): Fe = vr . J_r + vm . Jm (one matrix-vector product) +
+    # the dl/dQ energy terms; cm: the mass constant of each Jm row (0: not in the mass)
+    cm = np.zeros(K)
+    for i in range(3):
+        cm[i] = Jrot[i] if inertia else 0.0
+    if strains:
+        for r in range(4):
+            cm[3 + r] = (h * h / 6.0) * D[r] if filt else 0.0
     if conv:
         acc_c, wdot_c, eddot_c, om_c, ed_c = _convective_rates(
             qde, cstep, n, cx[0], cx[1], cx[2], cx[3], cx[4], cx[5], cx[6], cx[7], cx[8], i_s1,
             filt)
-    v = np.zeros((G, K))
+    vr = np.zeros((G, 3))
+    vm = np.zeros((G, K))
     Fe_extra = np.zeros(nq)
     total = 0.0
     omega = np.empty(3)
@@ -344,44 +352,51 @@ def _mass_force(qe, qde, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_drow
         mr = wl[g] * rhoA
         if inertia:
             for j in range(3):
-                v[g, j] -= mr * acc_c[g, j]
+                vr[g, j] -= mr * acc_c[g, j]
             for i in range(3):              # J_w q_dot (the rates' real part)
                 omega[i] = om_c[g, i]
                 jw[i] = Jrot[i] * om_c[g, i]
-            v[g, 3] -= wl[g] * (Jrot[0] * wdot_c[g, 0] + omega[1] * jw[2] - omega[2] * jw[1])
-            v[g, 4] -= wl[g] * (Jrot[1] * wdot_c[g, 1] + omega[2] * jw[0] - omega[0] * jw[2])
-            v[g, 5] -= wl[g] * (Jrot[2] * wdot_c[g, 2] + omega[0] * jw[1] - omega[1] * jw[0])
+            vm[g, 0] -= wl[g] * (Jrot[0] * wdot_c[g, 0] + omega[1] * jw[2] - omega[2] * jw[1])
+            vm[g, 1] -= wl[g] * (Jrot[1] * wdot_c[g, 1] + omega[2] * jw[0] - omega[0] * jw[2])
+            vm[g, 2] -= wl[g] * (Jrot[2] * wdot_c[g, 2] + omega[0] * jw[1] - omega[1] * jw[0])
         if gravity:
             for j in range(3):
-                v[g, j] += mr * grav[j]
+                vr[g, j] += mr * grav[j]
         if elasticity:
             W = 0.0
             for r in range(4):
                 sig = eps[g, r] * D[r]
-                v[g, 6 + r] -= wl[g] * sig
+                vm[g, 3 + r] -= wl[g] * sig
                 W += 0.5 * sig * eps[g, r]
                 for c in range(2):                                    # B_xi = B_s + eps' ds/dchi
                     Fe_extra[i_s1 + c] -= wl[g] * sig * cp_ds[g, r, c]
             total += q_w[g] * W                                       # dU/dl at fixed xi
         if filt:
             for r in range(4):              # B_s q_dot (the rates' real part)
-                v[g, 6 + r] -= wl[g] * D[r] * (0.5 * h * ed_c[g, r]
-                                               + (h * h / 6.0) * eddot_c[g, r])
+                vm[g, 3 + r] -= wl[g] * D[r] * (0.5 * h * ed_c[g, r]
+                                                + (h * h / 6.0) * eddot_c[g, r])
         if qdde.shape[0] > 0:           # - Me qdde = - sum_rows (w c) J^T (J qdde)
+            if inertia and rhoA != 0.0:
+                for j in range(3):
+                    acc = Jrs[g, j, 0] * qdde[i_s1] + Jrs[g, j, 1] * qdde[i_s1 + 1]
+                    for a in range(na):
+                        acc += X[g, 0, a] * qdde[3 * a + j]
+                    vr[g, j] -= wl[g] * rhoA * acc
             for i in range(K):
-                if i < 3:
-                    c = rhoA if inertia else 0.0
-                elif i < 6:
-                    c = Jrot[i - 3] if inertia else 0.0
-                else:
-                    c = (h * h / 6.0) * D[i - 6] if filt else 0.0
-                if c != 0.0:
+                if cm[i] != 0.0:
                     acc = 0.0
                     for k in range(nq):
-                        acc += J[g, i, k] * qdde[k]
-                    v[g, i] -= wl[g] * c * acc
-    J2 = J.reshape(G * K, nq)
-    Fe = np.dot(v.reshape(G * K), J2)
+                        acc += Jm[g, i, k] * qdde[k]
+                    vm[g, i] -= wl[g] * cm[i] * acc
+    Fe = np.dot(vm.reshape(G * K), Jm.reshape(G * K, nq))
+    for g in range(G):                  # vr . J_r in its structure
+        for a in range(na):
+            x0 = X[g, 0, a]
+            for j in range(3):
+                Fe[3 * a + j] += vr[g, j] * x0
+        for c in range(2):
+            Fe[i_s1 + c] += vr[g, 0] * Jrs[g, 0, c] + vr[g, 1] * Jrs[g, 1, c] \
+                + vr[g, 2] * Jrs[g, 2, c]
     for k in range(nq):
         Fe[k] += Fe_extra[k]
     if elasticity:
@@ -393,41 +408,40 @@ def _mass_force(qe, qde, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_drow
         if needs_mass:
             return np.zeros((nq, nq)), Fe
         return np.zeros((0, 0)), Fe
-    # mass: Me = A^T A with the weighted rows sqrt(w c) J of all points (one BLAS product); rows
-    # of a zero constant c (e.g. J_t = J_b = 0) are left out.  The translational rows J_r are
-    # X_0 (x) I_3 on the position coefficients (and two s columns): their sum is formed in that
-    # structure (_add_translational_mass), not in the product
-    sel = np.empty(10, dtype=np.int64)
-    cm = np.empty(10)
+    # mass: Me = A^T A with the weighted rows sqrt(w c) Jm of all points (one BLAS product; the
+    # rows scaled in place where every c is non-zero, else the rows of a non-zero c copied
+    # out, e.g. J_t = J_b = 0), plus the translational sum w rhoA J_r^T J_r formed in the
+    # structure of J_r (_add_translational_mass)
     km = 0
-    if inertia:
-        for i in range(3, 6):
-            c = Jrot[i - 3]
-            if c != 0.0:
-                sel[km] = i
-                cm[km] = c
-                km += 1
-    if filt:
-        for r in range(4):
-            if D[r] != 0.0:
-                sel[km] = 6 + r
-                cm[km] = (h * h / 6.0) * D[r]
-                km += 1
-    A = np.empty((G, km, nq))
-    for g in range(G):
-        for i in range(km):
-            wi = np.sqrt(wl[g] * cm[i])
-            for k in range(nq):
-                A[g, i, k] = J[g, sel[i], k] * wi
-    Me = _gram(A.reshape(G * km, nq))
+    for i in range(K):
+        if cm[i] != 0.0:
+            km += 1
+    if km == K:
+        for g in range(G):
+            for i in range(K):
+                wi = np.sqrt(wl[g] * cm[i])
+                for k in range(nq):
+                    Jm[g, i, k] *= wi
+        Me = _gram(Jm.reshape(G * K, nq))
+    else:
+        A = np.empty((G, km, nq))
+        for g in range(G):
+            q = 0
+            for i in range(K):
+                if cm[i] != 0.0:
+                    wi = np.sqrt(wl[g] * cm[i])
+                    for k in range(nq):
+                        A[g, q, k] = Jm[g, i, k] * wi
+                    q += 1
+        Me = _gram(A.reshape(G * km, nq))
     if inertia and rhoA != 0.0:
-        _add_translational_mass(Me, J, X, wl, rhoA, na, i_s1)
+        _add_translational_mass(Me, Jrs, X, wl, rhoA, na, i_s1)
     return Me, Fe
 
 
-def _add_translational_mass(Me, J, X, wl, rhoA, na, i_s1):
+def _add_translational_mass(Me, Jrs, X, wl, rhoA, na, i_s1):
     """Me += sum_g w_g rhoA J_r^T J_r, with J_r = X_0 (x) I_3 on the position coefficients
-    (J[g, j, 3 a + j] = X[g, 0, a]) and the s columns J[g, j, i_s1 + c]: the (na, na) sum
+    (J_r[g, j, 3 a + j] = X[g, 0, a]) and the s columns Jrs[g, j, c]: the (na, na) sum
     sum_g w rhoA X_0 X_0^T on the diagonal of every 3 x 3 block, the position-s and s-s
     couplings from the s columns (the same sums as the product, grouped)."""
     G = X.shape[0]
@@ -442,12 +456,12 @@ def _add_translational_mass(Me, J, X, wl, rhoA, na, i_s1):
                 K0[a, b] += xa * X[g, 0, b]
             for j in range(3):
                 for cc in range(2):
-                    Ks[a, j, cc] += xa * J[g, j, i_s1 + cc]
+                    Ks[a, j, cc] += xa * Jrs[g, j, cc]
         for cc in range(2):
             for dd in range(2):
                 acc = 0.0
                 for j in range(3):
-                    acc += J[g, j, i_s1 + cc] * J[g, j, i_s1 + dd]
+                    acc += Jrs[g, j, cc] * Jrs[g, j, dd]
                 Kss[cc, dd] += c * acc
     for a in range(na):
         for b in range(na):
