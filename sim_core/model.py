@@ -79,6 +79,9 @@ class Model:
     # since 2026-11-24 (fourth session): six Cholesky factors of 46 instead of three of 104 and
     # a border of 68 instead of 33, 233 -> 186 us per factorisation at 8 sub-elements
     kkt_blocks: bool = True
+    # payloads and ropes from one compiled evaluation of their points
+    # (point_effects.CompiledPointEffects); False: each effect's local() in Python (the reference)
+    point_effects_compiled: bool = True
     # the element batch on a worker thread while the constraint rows are evaluated
     # (_element_blocks_started); False: on the calling thread
     element_thread: bool = True
@@ -285,9 +288,12 @@ class Model:
         for pl in self.point_loads:
             put(*self._point_load_terms(pl, t, Q))
         rest = []
+        batch = self._compiled_point_effects() if not np.iscomplexobj(Q) \
+            and not np.iscomplexobj(Qd) else None
+        local = iter(batch.local(Q, Qd, mass)) if batch is not None else None
         for pe in self.point_effects:
             if hasattr(pe, "local"):
-                idx, Me, Fe = pe.local(t, Q, Qd, mass)
+                idx, Me, Fe = next(local) if local is not None else pe.local(t, Q, Qd, mass)
                 if Me is not None and not coupled:
                     o = self._block_of()[idx]
                     o = o[o >= 0]
@@ -305,6 +311,19 @@ class Model:
             for el, idx in self.element_indices():
                 put(idx, *self.element_terms(t, el, Q[idx], Qd[idx], mass))
         return rest, coupled
+
+    def _compiled_point_effects(self):
+        """The point effects' local blocks from one compiled evaluation
+        (point_effects.CompiledPointEffects) where ``point_effects_compiled`` and it covers
+        them, else None."""
+        if not self.point_effects_compiled:
+            return None
+        key = tuple(id(pe) for pe in self.point_effects)
+        hit = self.__dict__.get("_pe_batch")
+        if hit is None or hit[0] != key:
+            from .point_effects import CompiledPointEffects
+            hit = self._pe_batch = (key, CompiledPointEffects.build(self.point_effects))
+        return hit[1]
 
     def _element_blocks_started(self, t, Q, Qd):
         """Start the mass matrices and forces of all elements as one compiled batch

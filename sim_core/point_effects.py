@@ -119,3 +119,52 @@ def _add_local(terms, M, F) -> None:
     F[idx] += Fe
     if M is not None and Me is not None:
         M[np.ix_(idx, idx)] += Me
+
+
+class CompiledPointEffects:
+    """The local blocks of a list of payloads and ropes from one compiled evaluation of their
+    points (:mod:`sim_core.constraint_compiled`: a rope's length is a chain of distances, the
+    rows the rope-length constraint uses; a payload's point is a coincidence row of one point,
+    whose Jacobian is J and whose quadratic term is the convective acceleration J_dot q_dot).
+    The same formulas as ``PointMass.local`` and ``RopeDrive.local`` (the reference:
+    ``tests/telescopic/test_assembly_paths.py``); :meth:`build` returns None where an effect
+    is of another kind or a point is not a material or fixed point."""
+
+    def __init__(self, effects, rows, program):
+        self.effects, self.rows, self.program = effects, rows, program
+
+    @staticmethod
+    def build(effects) -> "CompiledPointEffects | None":
+        from .constraint_compiled import DIFF_R, ROPE, program_for
+        from .constraints import NonlinearConstraint
+        if not effects or not all(type(pe) in (PointMass, RopeDrive) for pe in effects):
+            return None
+        cons, rows, row = [], [], 0
+        for pe in effects:
+            if isinstance(pe, PointMass):
+                spec, m = (DIFF_R, (0, 1, 2), (pe.point,)), 3
+            else:
+                spec, m = (ROPE, (), tuple(pe.points)), 1
+            cons.append(NonlinearConstraint(pe.name, m, None, program=spec))
+            rows.append(slice(row, row + m))
+            row += m
+        program = program_for(cons)
+        return None if program is None else CompiledPointEffects(effects, rows, program)
+
+    def local(self, Q, Qd, mass=True) -> list:
+        """[(idx, Me or None, Fe)] of every effect, in order (as its ``local``)."""
+        g, G, quad, _ = self.program.terms(Q, Qd)
+        out = []
+        for pe, sl in zip(self.effects, self.rows):
+            if isinstance(pe, PointMass):
+                idx = _cols(pe.coords(Q), Q)
+                J = G[sl][:, idx]
+                f = -pe.mass * quad[sl]
+                if pe.gravity is not None:
+                    f = f + pe.mass * pe.gravity
+                out.append((idx, (pe.mass * (J.T @ J) if mass else None), J.T @ f))
+            else:
+                grad = G[sl.start]
+                idx = np.flatnonzero(grad)
+                out.append((idx, None, -pe.tension(float(g[sl.start])) * grad[idx]))
+        return out

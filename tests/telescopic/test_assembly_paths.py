@@ -385,3 +385,40 @@ def test_a_point_mass_across_two_elements_takes_the_whole_matrix(state):
         finally:
             m.point_effects.pop()
         assert (blocks is None) == whole, idx
+
+
+def test_compiled_point_effects_equal_their_local_blocks(state):
+    """The payload and rope blocks from one compiled evaluation of their points
+    (point_effects.CompiledPointEffects) against each effect's ``local`` (the reference):
+    the same formulas on the same point kinematics, equal to round-off (the fixture's
+    extraction rope is taut, the retraction rope slack); and the right-hand side with and
+    without them."""
+    from sim_core.point_effects import CompiledPointEffects, PointMass, RopeDrive
+    ts, z, zd = state
+    m = ts.model
+    if not m.point_effects or CompiledPointEffects.build(m.point_effects) is None:
+        pytest.skip("numba not installed: no compiled point effects")
+    kinds = {type(pe) for pe in m.point_effects}
+    assert kinds == {PointMass, RopeDrive}
+    t = 0.3
+    Q, Qd = m.full_state(t, z, zd)
+    batch = CompiledPointEffects.build(m.point_effects)
+    tensions = []
+    for pe, (idx, Me, Fe) in zip(m.point_effects, batch.local(Q, Qd)):
+        idx0, Me0, Fe0 = pe.local(t, Q, Qd)
+        np.testing.assert_array_equal(idx, idx0)
+        scale = max(np.abs(Fe0).max(), 1.0)
+        np.testing.assert_allclose(Fe, Fe0, rtol=0, atol=1e-12 * scale)
+        if Me0 is None:
+            assert Me is None
+            tensions.append(float(np.abs(Fe0).max()))
+        else:
+            np.testing.assert_allclose(Me, Me0, rtol=0, atol=1e-12 * np.abs(Me0).max())
+    assert max(tensions) > 0                     # a taut rope is among them
+    y = np.concatenate([z, zd])
+    m.point_effects_compiled = False
+    try:
+        ref = m.rhs(t, y)
+    finally:
+        m.point_effects_compiled = True
+    np.testing.assert_allclose(m.rhs(t, y), ref, rtol=0, atol=1e-9 * np.abs(ref).max())
