@@ -4,7 +4,9 @@ The same algorithm as :func:`sim_core.constraints._kkt_factor_blocks` (the refer
 fallback): Cholesky of each beam block A_i = M_r[b_i, b_i], B_i = [M_r[b_i, r], C[:, b_i]^T],
 the Schur complement S = D - sum_i B_i^T A_i^-1 B_i of the border (coordinates in no block and
 the multipliers; LU with partial pivoting), and every solve followed by one step of iterative
-refinement on the whole system.  As one compiled factorisation and one compiled solve the ~30
+refinement on the whole system (its residual from the blocks, their border columns and the
+border rows: the non-zero parts of M_r only; a right-hand side that is zero on a block, e.g.
+a unit load on a border coordinate, skips that block's solve).  As one compiled factorisation and one compiled solve the ~30
 LAPACK and numpy calls of the Python version (each with its call overhead; 0.4 ms + 0.25 ms
 per telescopic right-hand side at 8 sub-elements) become two.  LAPACK (dpotrf, dpotrs, dgetrf,
 dgetrs of scipy's ``cython_lapack``) is called through external symbols, as
@@ -79,10 +81,16 @@ def _factor(Mr, C, blocks, lens, r):
     m = C.shape[0]
     nb = nr + m
     facs = np.zeros((k, L, L))
+    As = np.zeros((k, L, L))                 # the blocks themselves (for the residual)
     Bs = np.zeros((k, L, nb))
     Ys = np.zeros((k, L, nb))
     S = np.zeros((nb, nb))
     CT = C.T.copy()
+    n = Mr.shape[0]
+    Mrr = np.empty((nr, n))                  # the border rows of Mr
+    for i in range(nr):
+        for j in range(n):
+            Mrr[i, j] = Mr[r[i], j]
     for i in range(nr):
         for j in range(nr):
             S[i, j] = Mr[r[i], r[j]]
@@ -95,8 +103,9 @@ def _factor(Mr, C, blocks, lens, r):
         for i in range(nq):
             for j in range(nq):
                 A[i, j] = Mr[blocks[q, i], blocks[q, j]]
+                As[q, i, j] = A[i, j]
         if _chol(A, nq) != 0:
-            return False, facs, Bs, Ys, S, np.zeros(nb, dtype=np.int32), CT
+            return False, facs, Bs, Ys, S, np.zeros(nb, dtype=np.int32), CT, As, Mrr
         for i in range(nq):
             bi = blocks[q, i]
             for j in range(nr):
@@ -132,7 +141,7 @@ def _factor(Mr, C, blocks, lens, r):
     nn = _i32(nb)
     info = _i32(0)
     _dgetrf(nn.ctypes, nn.ctypes, St.ctypes, nn.ctypes, piv.ctypes, info.ctypes)
-    return info[0] == 0, facs, Bs, Ys, St, piv, CT
+    return info[0] == 0, facs, Bs, Ys, St, piv, CT, As, Mrr
 
 
 def _once(facs, Bs, Ys, St, piv, blocks, lens, r, F, c):
@@ -153,9 +162,14 @@ def _once(facs, Bs, Ys, St, piv, blocks, lens, r, F, c):
     for q in range(k):
         nq = lens[q]
         ut = us[q]
+        nonzero = False
         for j in range(nrhs):
             for i in range(nq):
                 ut[j, i] = F[blocks[q, i], j]
+                if ut[j, i] != 0.0:
+                    nonzero = True
+        if not nonzero:                          # u = A^-1 0 = 0 (e.g. a unit load on the
+            continue                             # border: the friction Newton's columns)
         _chol_solve(facs[q], nq, ut)
         gt -= np.dot(ut, Bs[q])                  # (B^T u)^T = u^T B; zero padding
     trans = np.array([ord("N")], dtype=np.uint8)
@@ -183,10 +197,40 @@ def _once(facs, Bs, Ys, St, piv, blocks, lens, r, F, c):
     return z, mu
 
 
-def _solve(Mr, C, CT, facs, Bs, Ys, St, piv, blocks, lens, r, F, c, refine):
+def _times_Mr(As, Bs, Mrr, blocks, lens, r, z):
+    """Mr z from the blocks, their border columns (Bs[:, :, :nr]) and the border rows Mrr:
+    the products of the non-zero parts of Mr only (block-diagonal plus border)."""
+    k = blocks.shape[0]
+    n, nrhs = z.shape
+    nr = r.shape[0]
+    out = np.dot(Mrr, z)                         # the border rows
+    y = np.zeros((n, nrhs))
+    for i in range(nr):
+        for j in range(nrhs):
+            y[r[i], j] = out[i, j]
+    zr = np.empty((nr, nrhs))
+    for i in range(nr):
+        for j in range(nrhs):
+            zr[i, j] = z[r[i], j]
+    for q in range(k):
+        nq = lens[q]
+        zq = np.empty((nq, nrhs))
+        for i in range(nq):
+            for j in range(nrhs):
+                zq[i, j] = z[blocks[q, i], j]
+        t = np.dot(np.ascontiguousarray(As[q, :nq, :nq]), zq)
+        if nr > 0:
+            t += np.dot(np.ascontiguousarray(Bs[q, :nq, :nr]), zr)
+        for i in range(nq):
+            for j in range(nrhs):
+                y[blocks[q, i], j] = t[i, j]
+    return y
+
+
+def _solve(Mr, C, CT, facs, Bs, Ys, St, piv, blocks, lens, r, F, c, refine, As, Mrr):
     z, mu = _once(facs, Bs, Ys, St, piv, blocks, lens, r, F, c)
     if refine:
-        rF = F - np.dot(Mr, z) - np.dot(CT, mu)
+        rF = F - _times_Mr(As, Bs, Mrr, blocks, lens, r, z) - np.dot(CT, mu)
         rc = c - np.dot(C, z)
         dz, dmu = _once(facs, Bs, Ys, St, piv, blocks, lens, r, rF, rc)
         z = z + dz
@@ -201,6 +245,7 @@ if AVAILABLE:
     _chol_solve = _jit(_chol_solve)
     _factor_compiled = _jit(_factor)
     _once = _jit(_once)
+    _times_Mr = _jit(_times_Mr)
     _solve_compiled = _jit(_solve)
 
 
@@ -220,7 +265,7 @@ def kkt_factor_blocks(Mr, C, blocks, refine: bool = True):
     r = np.flatnonzero(mask).astype(np.int64)
     Mr = np.ascontiguousarray(Mr, dtype=float)
     C = np.ascontiguousarray(C, dtype=float)
-    ok, facs, Bs, Ys, St, piv, CT = _factor_compiled(Mr, C, B, lens, r)
+    ok, facs, Bs, Ys, St, piv, CT, As, Mrr = _factor_compiled(Mr, C, B, lens, r)
     if not ok:
         return None
 
@@ -230,6 +275,7 @@ def kkt_factor_blocks(Mr, C, blocks, refine: bool = True):
         vec = F.ndim == 1
         F2 = np.ascontiguousarray(F.reshape(n, -1))
         c2 = np.ascontiguousarray(c.reshape(m, -1))
-        z, mu = _solve_compiled(Mr, C, CT, facs, Bs, Ys, St, piv, B, lens, r, F2, c2, refine)
+        z, mu = _solve_compiled(Mr, C, CT, facs, Bs, Ys, St, piv, B, lens, r, F2, c2, refine,
+                                As, Mrr)
         return (z[:, 0], -mu[:, 0]) if vec else (z, -mu)
     return solve
