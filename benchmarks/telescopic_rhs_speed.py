@@ -41,6 +41,8 @@ last evaluation, and a benchmark that repeats one state measures cache hits.  Va
   in one compiled call (``constraints.COMPILED_ROWS``, ``sim_core.constraint_compiled``),
 * ``+ friction Newton warm-started`` and the friction-multiplier Newton started from the last
   solution (``Model.multiplier_warm_start``; before: from zero friction),
+* ``+ payload and ropes in one compiled call`` and the payload's and the ropes' blocks from
+  one compiled evaluation of their points (``Model.point_effects_compiled``),
 
 All variants assemble the reduced system block by block and evaluate each material point once
 for the real and complex-step states (2026-11-24, second session; before, the full N x N mass
@@ -50,8 +52,10 @@ They also share what the third session (2026-11-24) changed without a switch: th
 section maps in closed form, the saddle-point factor on the border columns that touch each
 block, the element convective rows from tables, the element blocks scattered in one call (the
 second session's table of this script is ``results/telescopic_rhs_speed_dc97a83.md``), and
-what the fourth changed in the element kernel without a switch: the kinematics once at the
-complex-step state, the translational mass in its Kronecker structure (the third session's
+what the fourth changed without a switch: in the element kernel the kinematics once at the
+complex-step state, J_r in its Kronecker structure (the translational mass without the BLAS
+product, omega and eps_dot as real parts of the convective sums), the saddle-point blocks per
+element instead of per beam, the refinement residual from the blocks (the third session's
 table is ``results/telescopic_rhs_speed_af1e8ab.md``).
 
 then a cProfile of the last variant without the worker thread, grouped by what the time is
@@ -87,24 +91,28 @@ OUT = os.path.join(os.path.dirname(__file__), "results", "telescopic_rhs_speed.m
 # element mass and forces, block elimination of the saddle-point system, compiled scatter,
 # the element batch on a worker thread, the GIL handed to the worker after submitting,
 # material points in one compiled call, the friction Newton's loop in one compiled call, the
-# constraint rows as one compiled program, the friction Newton warm-started)
+# constraint rows as one compiled program, the friction Newton warm-started, the payload and
+# ropes from one compiled evaluation of their points)
 _F, _T = False, True
 VARIANTS = (
-    ("fixed point, numpy", _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
-    ("Newton, numpy", _T, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
-    ("+ compiled section", _T, _T, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
-    ("+ compiled micro-motion", _T, _T, _T, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
-    ("+ compiled points", _T, _T, _T, _T, _F, _F, _F, _F, _F, _F, _F, _F, _F),
-    ("+ compiled elements", _T, _T, _T, _T, _T, _F, _F, _F, _F, _F, _F, _F, _F),
-    ("+ block saddle-point solve", _T, _T, _T, _T, _T, _T, _F, _F, _F, _F, _F, _F, _F),
-    ("+ compiled scatter", _T, _T, _T, _T, _T, _T, _T, _F, _F, _F, _F, _F, _F),
-    ("+ elements on a worker thread", _T, _T, _T, _T, _T, _T, _T, _T, _F, _F, _F, _F, _F),
-    ("+ GIL handed to the worker", _T, _T, _T, _T, _T, _T, _T, _T, _T, _F, _F, _F, _F),
-    ("+ points in one compiled call", _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _F, _F, _F),
-    ("+ friction Newton in one compiled call", _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _F, _F),
+    ("fixed point, numpy", _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
+    ("Newton, numpy", _T, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
+    ("+ compiled section", _T, _T, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
+    ("+ compiled micro-motion", _T, _T, _T, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
+    ("+ compiled points", _T, _T, _T, _T, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
+    ("+ compiled elements", _T, _T, _T, _T, _T, _F, _F, _F, _F, _F, _F, _F, _F, _F),
+    ("+ block saddle-point solve", _T, _T, _T, _T, _T, _T, _F, _F, _F, _F, _F, _F, _F, _F),
+    ("+ compiled scatter", _T, _T, _T, _T, _T, _T, _T, _F, _F, _F, _F, _F, _F, _F),
+    ("+ elements on a worker thread", _T, _T, _T, _T, _T, _T, _T, _T, _F, _F, _F, _F, _F, _F),
+    ("+ GIL handed to the worker", _T, _T, _T, _T, _T, _T, _T, _T, _T, _F, _F, _F, _F, _F),
+    ("+ points in one compiled call", _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _F, _F, _F, _F),
+    ("+ friction Newton in one compiled call",
+     _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _F, _F, _F),
     ("+ constraint rows in one compiled program",
-     _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _F),
-    ("+ friction Newton warm-started", _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T),
+     _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _F, _F),
+    ("+ friction Newton warm-started", _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _F),
+    ("+ payload and ropes in one compiled call", _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T,
+     _T, _T),
 )
 
 # cProfile groups: (label, "module file:function" names whose cumulative time is the group's;
@@ -126,8 +134,9 @@ GROUPS = (
 def _configure(m, newton: bool, section: bool, micro: bool, points: bool,
                elements: bool, blocks: bool, scatter: bool, thread: bool, handover: bool,
                points_one_call: bool, newton_compiled: bool, rows_compiled: bool,
-               warm_start: bool) -> None:
+               warm_start: bool, point_effects_compiled: bool) -> None:
     m.multiplier_newton = newton
+    m.point_effects_compiled = point_effects_compiled
     m.multiplier_warm_start = warm_start
     constraints.COMPILED_ROWS = rows_compiled
     m.element_thread = thread
