@@ -249,11 +249,18 @@ if AVAILABLE:
     _solve_compiled = _jit(_solve)
 
 
-def kkt_factor_blocks(Mr, C, blocks, refine: bool = True):
-    """solve(Fr, c_rhs) -> (z_ddot, lambda) as :func:`sim_core.constraints._kkt_factor_blocks`
-    (vectors or matrices of right-hand sides), compiled; None where a block is not positive
-    definite or the border's LU is singular (the caller falls back to the whole matrix's LU)."""
-    n, m = Mr.shape[0], C.shape[0]
+_LAYOUT: list = []          # [(n, the blocks list, its arrays, layout)]: the last one used
+
+
+def _layout(n, blocks):
+    """(padded block table (k, L), block lengths, border coordinates) of ``blocks``; the last
+    layout is kept, keyed on the blocks list and its arrays themselves (a model passes the same
+    list at every call)."""
+    if _LAYOUT:
+        n0, ref, arrays, out = _LAYOUT[0]
+        if n0 == n and ref is blocks and len(arrays) == len(blocks) \
+                and all(a is b for a, b in zip(arrays, blocks)):
+            return out
     k = len(blocks)
     lens = np.array([len(b) for b in blocks], dtype=np.int64)
     L = int(lens.max()) if k else 0
@@ -262,7 +269,17 @@ def kkt_factor_blocks(Mr, C, blocks, refine: bool = True):
     for q, b in enumerate(blocks):
         B[q, :len(b)] = b
         mask[b] = False
-    r = np.flatnonzero(mask).astype(np.int64)
+    out = (B, lens, np.flatnonzero(mask).astype(np.int64))
+    _LAYOUT[:] = [(n, blocks, list(blocks), out)]
+    return out
+
+
+def kkt_factor_blocks(Mr, C, blocks, refine: bool = True):
+    """solve(Fr, c_rhs) -> (z_ddot, lambda) as :func:`sim_core.constraints._kkt_factor_blocks`
+    (vectors or matrices of right-hand sides), compiled; None where a block is not positive
+    definite or the border's LU is singular (the caller falls back to the whole matrix's LU)."""
+    n, m = Mr.shape[0], C.shape[0]
+    B, lens, r = _layout(n, blocks)
     Mr = np.ascontiguousarray(Mr, dtype=float)
     C = np.ascontiguousarray(C, dtype=float)
     ok, facs, Bs, Ys, St, piv, CT, As, Mrr = _factor_compiled(Mr, C, B, lens, r)
