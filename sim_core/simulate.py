@@ -353,9 +353,13 @@ def integrate(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
 
     def stats():
         wall = time.perf_counter() - wall0
+        # the smallest accepted step, not counting the last one of a finished run: the solver
+        # cuts that one to land on t_end, so its length is set by where t_end falls, not by the
+        # dynamics (a run whose steps collapse elsewhere still shows it)
+        inner = steps[:-1] if solver.status == "finished" and len(steps) > 1 else steps
         out = {"wall_time_s": wall, "n_steps": len(steps), "n_rhs": int(rhs.nfev),
                "n_failed_rhs": int(rhs.n_failed),
-               "min_step_s": float(min(steps)) if steps else 0.0,
+               "min_step_s": float(min(inner)) if inner else 0.0,
                "max_step_s": float(max(steps)) if steps else 0.0,
                "method": method, "real_time_factor": t_end / max(wall, 1e-12)}
         if method != "RK45":
