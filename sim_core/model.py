@@ -448,8 +448,8 @@ class Model:
     def _reduced_mass_force_at(self, t, Q, Qd, Qdd_p, blocks: bool = False, elements=None):
         """(M_r, F_r) at the full state; ``blocks``: and the reduced coordinates of each
         element's own coordinates (:meth:`_block_of`) where M_r is block-diagonal in them (no
-        point effect's mass couples two of them), else None (for ``constraints.kkt_factor``).  ``elements``: the element batch if already
-        started (:meth:`_element_blocks_started`)."""
+        point effect's mass couples two of them), else None (for ``constraints.kkt_factor``).
+        ``elements``: the element batch if already started (:meth:`_element_blocks_started`)."""
         if self._sel is None:
             if elements is not None:
                 elements()                      # not used on this path: wait for it
