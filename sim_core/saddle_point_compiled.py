@@ -1,14 +1,15 @@
 """Compiled (numba) block elimination of the saddle-point system over diagonal blocks of M_r.
 
 The same algorithm as :func:`sim_core.constraints._kkt_factor_blocks` (the reference and the
-fallback): Cholesky of each beam block A_i = M_r[b_i, b_i], B_i = [M_r[b_i, r], C[:, b_i]^T],
-the Schur complement S = D - sum_i B_i^T A_i^-1 B_i of the border (coordinates in no block and
-the multipliers; LU with partial pivoting), and every solve followed by one step of iterative
-refinement on the whole system (its residual from the blocks, their border columns and the
-border rows: the non-zero parts of M_r only; a right-hand side that is zero on a block, e.g.
-a unit load on a border coordinate, skips that block's solve).  As one compiled factorisation and one compiled solve the ~30
-LAPACK and numpy calls of the Python version (each with its call overhead; 0.4 ms + 0.25 ms
-per telescopic right-hand side at 8 sub-elements) become two.  LAPACK (dpotrf, dpotrs, dgetrf,
+fallback): Cholesky of each block A_i = M_r[b_i, b_i] (``Model``: an element's own
+coordinates), B_i = [M_r[b_i, r], C[:, b_i]^T], the Schur complement S = D - sum_i B_i^T
+A_i^-1 B_i of the border (coordinates in no block and the multipliers; LU with partial
+pivoting), and every solve followed by one step of iterative refinement on the whole system
+(its residual from the blocks, their border columns and the border rows: the non-zero parts
+of M_r only; a right-hand side that is zero on a block, e.g. a unit load on a border
+coordinate, skips that block's solve).  As one compiled factorisation and one compiled solve
+the ~30 LAPACK and numpy calls of the Python version (each with its call overhead; 0.4 ms +
+0.25 ms per telescopic right-hand side at 8 sub-elements) become two.  LAPACK (dpotrf, dpotrs, dgetrf,
 dgetrs of scipy's ``cython_lapack``) is called through external symbols, as
 :mod:`sim_core.beam.element_compiled` calls dsyrk, so the functions stay cacheable.
 ``tests/telescopic/test_assembly_paths.py`` checks both against the LU of the whole matrix.
