@@ -311,6 +311,7 @@ class ConstraintProgram:
         self.beam_count = np.array(count, dtype=np.int64)
         P = len(points)
         self.P = P
+        self.points = points
         self.p_fixed = np.zeros(P, dtype=np.bool_)
         self.p_r = np.zeros((P, 3))
         self.p_beam = np.zeros(P, dtype=np.int64)
@@ -372,30 +373,19 @@ class ConstraintProgram:
         return g, G, quad, (Gr if rate_part else None)
 
     def dependencies(self, Q) -> np.ndarray:
-        """(P, N) bool: the coordinates each point depends on at Q (its element's, and its
-        moving coordinate), as ``material_point``'s ``coords``."""
+        """(P, N) bool: the coordinates each point depends on at Q (its ``coords``: a
+        material point's element and moving coordinate, none for a fixed point)."""
         deps = np.zeros((self.P, self.N), dtype=np.bool_)
-        for p in range(self.P):
-            if self.p_fixed[p]:
-                continue
-            b = self.p_beam[p]
-            s = Q[self.p_sidx[p]].real if self.p_sidx[p] >= 0 else self.p_sfix[p]
-            e0, cnt = self.beam_first[b], self.beam_count[b]
-            e = e0 + cnt - 1
-            for k in range(cnt - 1):
-                if s < Q[self.el_right[e0 + k]].real:
-                    e = e0 + k
-                    break
-            deps[p, self.el_idx[e]] = True
-            if self.p_sidx[p] >= 0:
-                deps[p, self.p_sidx[p]] = True
+        for p, f in enumerate(self.points):
+            deps[p, f.coords(Q)] = True
         return deps
 
-    def columns(self, Q, Qd, Qdd, lam, b0, bd, bdd, xi1, xi2, cols, steps):
+    def columns(self, Q, Qd, Qdd, lam, b0, bd, bdd, xi1, xi2, cols, steps, deps=None):
         """Forward-difference columns ``cols`` (steps ``steps``) of G^T lambda (N, ncols) and
-        of the acceleration-level rows (m, ncols), see _columns."""
+        of the acceleration-level rows (m, ncols), see _columns; ``deps``: the points'
+        :meth:`dependencies` at Q where the caller has them."""
         f = np.ascontiguousarray
-        deps = self.dependencies(Q)
+        deps = self.dependencies(Q) if deps is None else deps
         dR1, dR2, total = _columns_compiled(
             f(Q, dtype=float), f(Qd, dtype=float), f(Qdd, dtype=float), f(lam, dtype=float),
             f(b0, dtype=float), f(bd, dtype=float), f(bdd, dtype=float), float(xi1),

@@ -23,7 +23,9 @@ from typing import Callable
 
 import numpy as np
 
+from . import constraint_compiled
 from .beam import point_compiled
+from .constraint_compiled import DIFF_PSI, DIFF_R, DISTANCE, ROPE
 
 Vec = np.ndarray
 
@@ -95,7 +97,6 @@ def constraint_terms(cons: list[NonlinearConstraint], t: float, Q: Vec, Qd: Vec)
         return e, np.zeros((0, len(Q))), e, e
     real = not (np.iscomplexobj(Q) or np.iscomplexobj(Qd))
     if real and COMPILED_ROWS:
-        from . import constraint_compiled
         prog = constraint_compiled.program_for(cons)
         if prog is not None:
             g, G, quad, _ = prog.terms(Q, Qd)
@@ -369,7 +370,8 @@ def _coincidence(name: str, fa, fb, fixed, part: int) -> NonlinearConstraint:
         return a[2 * part] - b[2 * part], a[2 * part + 1] - b[2 * part + 1]
     pts = (fa,) if fb is None else (fa, fb)
     return NonlinearConstraint(name, 3, evaluate, None if fixed is None else _fixed(fixed),
-                               points=pts, program=(part, (0, 1, 2), pts))
+                               points=pts,
+                               program=(DIFF_PSI if part else DIFF_R, (0, 1, 2), pts))
 
 
 def point_coincidence(name: str, fa, fb=None, fixed=None) -> NonlinearConstraint:
@@ -394,7 +396,7 @@ def distance_driver(name: str, fa, fb, length) -> NonlinearConstraint:
         n = np.sqrt(d @ d)
         return np.atleast_1d(n), ((d / n) @ (Ja - Jb))[None, :]
     return NonlinearConstraint(name, 1, evaluate, length, points=(fa, fb),
-                               program=(2, (), (fa, fb)))      # constraint_compiled.DISTANCE
+                               program=(DISTANCE, (), (fa, fb)))
 
 
 def rope_length(name: str, points, length: float) -> NonlinearConstraint:
@@ -415,4 +417,4 @@ def rope_length(name: str, points, length: float) -> NonlinearConstraint:
             J = J + (d / n) @ (Jb - Ja)
         return np.atleast_1d(ell), np.atleast_2d(J)
     return NonlinearConstraint(name, 1, evaluate, _fixed([length]), points=tuple(points),
-                               program=(3, (), tuple(points)))  # constraint_compiled.ROPE
+                               program=(ROPE, (), tuple(points)))

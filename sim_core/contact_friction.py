@@ -254,14 +254,12 @@ class FrictionAtState:
                           for (_, _, _, _, _, _, mu, geom) in self.regions]
         return self._mats
 
-    def newton(self, lam0, L, tol: float, max_iter: int, g0=None):
+    def newton(self, lam0, L, tol: float, max_iter: int, g0):
         """g solving g = g(lam0 + L g) by the multiplier Newton of Model._multiplier_newton
-        in one compiled call (micro_motion_compiled.multiplier_newton) from g0 (default 0), or
-        None where it does not apply (no compiled batch, a region that needs the reference
-        path)."""
+        in one compiled call (micro_motion_compiled.multiplier_newton) from g0, or None where
+        it does not apply (no compiled batch, a region that needs the reference path)."""
         if self._batch is None:
             return None
-        g0 = np.zeros(L.shape[1]) if g0 is None else g0
         return self._batch.newton(lam0, L, self.owner._x0, tol, max_iter, g0)
 
     def solve_regions(self, lam):

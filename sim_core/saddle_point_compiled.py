@@ -228,7 +228,7 @@ def _times_Mr(As, Bs, Mrr, blocks, lens, r, z):
     return y
 
 
-def _solve(Mr, C, CT, facs, Bs, Ys, St, piv, blocks, lens, r, F, c, refine, As, Mrr):
+def _solve(C, CT, facs, Bs, Ys, St, piv, blocks, lens, r, F, c, refine, As, Mrr):
     z, mu = _once(facs, Bs, Ys, St, piv, blocks, lens, r, F, c)
     if refine:
         rF = F - _times_Mr(As, Bs, Mrr, blocks, lens, r, z) - np.dot(CT, mu)
@@ -293,7 +293,7 @@ def kkt_factor_blocks(Mr, C, blocks, refine: bool = True):
         vec = F.ndim == 1
         F2 = np.ascontiguousarray(F.reshape(n, -1))
         c2 = np.ascontiguousarray(c.reshape(m, -1))
-        z, mu = _solve_compiled(Mr, C, CT, facs, Bs, Ys, St, piv, B, lens, r, F2, c2, refine,
-                                As, Mrr)
+        z, mu = _solve_compiled(C, CT, facs, Bs, Ys, St, piv, B, lens, r, F2, c2, refine, As,
+                                Mrr)
         return (z[:, 0], -mu[:, 0]) if vec else (z, -mu)
     return solve

@@ -147,12 +147,13 @@ def state_jacobian(model, t: float, y: np.ndarray, rel_step: float = REL_STEP,
     xi1, xi2 = model.baumgarte
     row = 0
     prog = None if central or not COMPILED_CONSTRAINT_COLUMNS else program_for(model.nonlinear)
+    G = None                               # g_Q at (Q, Q_dot), where the sweep forms it
     if prog is not None:        # all constraint pieces in one compiled sweep (same differences)
         b0, bd, bdd = targets(model.nonlinear, t)
         deps = prog.dependencies(Q)
         cols = np.flatnonzero(deps.any(axis=0))
         d1, d2 = prog.columns(Q, Qd, Qdd, lam, b0, bd, bdd, xi1, xi2, cols,
-                              _steps(Q[cols], rel_step))
+                              _steps(Q[cols], rel_step), deps)
         dR1[:, cols] += d1
         dR2[:, cols] += d2
         _, G, _, G_rate = prog.terms(Q, Qd, rate_part=True)     # d/dQ_dot as below
@@ -233,7 +234,8 @@ def state_jacobian(model, t: float, y: np.ndarray, rel_step: float = REL_STEP,
 
     Mr, _ = model.reduced_mass_force(t, z, zd)
     if m:
-        G = constraint_terms(model.nonlinear, t, Q, Qd)[1]
+        if G is None:
+            G = constraint_terms(model.nonlinear, t, Q, Qd)[1]
         C = XP(G)
     else:
         C = np.zeros((0, n))
