@@ -43,6 +43,10 @@ last evaluation, and a benchmark that repeats one state measures cache hits.  Va
   solution (``Model.multiplier_warm_start``; before: from zero friction),
 * ``+ payload and ropes in one compiled call`` and the payload's and the ropes' blocks from
   one compiled evaluation of their points (``Model.point_effects_compiled``),
+* ``+ persistent compiled worker`` and the element batch handed to a compiled worker loop
+  through a mailbox and an atomic state word instead of the thread pool
+  (``Model.element_spin``, ``sim_core.beam.element_worker``: no queue, no thread wake-up, no
+  GIL hand-over),
 
 All variants assemble the reduced system block by block and evaluate each material point once
 for the real and complex-step states (2026-11-24, second session; before, the full N x N mass
@@ -95,24 +99,26 @@ OUT = os.path.join(os.path.dirname(__file__), "results", "telescopic_rhs_speed.m
 # ropes from one compiled evaluation of their points)
 _F, _T = False, True
 VARIANTS = (
-    ("fixed point, numpy", _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
-    ("Newton, numpy", _T, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
-    ("+ compiled section", _T, _T, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
-    ("+ compiled micro-motion", _T, _T, _T, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
-    ("+ compiled points", _T, _T, _T, _T, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
-    ("+ compiled elements", _T, _T, _T, _T, _T, _F, _F, _F, _F, _F, _F, _F, _F, _F),
-    ("+ block saddle-point solve", _T, _T, _T, _T, _T, _T, _F, _F, _F, _F, _F, _F, _F, _F),
-    ("+ compiled scatter", _T, _T, _T, _T, _T, _T, _T, _F, _F, _F, _F, _F, _F, _F),
-    ("+ elements on a worker thread", _T, _T, _T, _T, _T, _T, _T, _T, _F, _F, _F, _F, _F, _F),
-    ("+ GIL handed to the worker", _T, _T, _T, _T, _T, _T, _T, _T, _T, _F, _F, _F, _F, _F),
-    ("+ points in one compiled call", _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _F, _F, _F, _F),
+    ("fixed point, numpy", _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
+    ("Newton, numpy", _T, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
+    ("+ compiled section", _T, _T, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
+    ("+ compiled micro-motion", _T, _T, _T, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
+    ("+ compiled points", _T, _T, _T, _T, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
+    ("+ compiled elements", _T, _T, _T, _T, _T, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
+    ("+ block saddle-point solve", _T, _T, _T, _T, _T, _T, _F, _F, _F, _F, _F, _F, _F, _F, _F),
+    ("+ compiled scatter", _T, _T, _T, _T, _T, _T, _T, _F, _F, _F, _F, _F, _F, _F, _F),
+    ("+ elements on a worker thread", _T, _T, _T, _T, _T, _T, _T, _T, _F, _F, _F, _F, _F, _F, _F),
+    ("+ GIL handed to the worker", _T, _T, _T, _T, _T, _T, _T, _T, _T, _F, _F, _F, _F, _F, _F),
+    ("+ points in one compiled call", _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _F, _F, _F, _F, _F),
     ("+ friction Newton in one compiled call",
-     _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _F, _F, _F),
+     _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _F, _F, _F, _F),
     ("+ constraint rows in one compiled program",
-     _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _F, _F),
-    ("+ friction Newton warm-started", _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _F),
+     _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _F, _F, _F),
+    ("+ friction Newton warm-started", _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _F, _F),
     ("+ payload and ropes in one compiled call", _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T,
-     _T, _T),
+     _T, _T, _F),
+    ("+ persistent compiled worker", _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T,
+     _T),
 )
 
 # cProfile groups: (label, "module file:function" names whose cumulative time is the group's;
@@ -134,8 +140,9 @@ GROUPS = (
 def _configure(m, newton: bool, section: bool, micro: bool, points: bool,
                elements: bool, blocks: bool, scatter: bool, thread: bool, handover: bool,
                points_one_call: bool, newton_compiled: bool, rows_compiled: bool,
-               warm_start: bool, point_effects_compiled: bool) -> None:
+               warm_start: bool, point_effects_compiled: bool, spin: bool) -> None:
     m.multiplier_newton = newton
+    m.element_spin = spin
     m.point_effects_compiled = point_effects_compiled
     m.multiplier_warm_start = warm_start
     constraints.COMPILED_ROWS = rows_compiled
