@@ -203,12 +203,21 @@ class ElementWorker:
         self.thread.start()
 
     def _settle(self) -> None:
-        """Leave the mailbox writable: wait out a request whose result was not collected; a
-        forked child (no worker thread of its own) -> EXITED."""
+        """Leave the state IDLE or EXITED, so that a post either succeeds or (EXITED) starts
+        the one worker: wait out a request whose result was not collected, drop a result that
+        was not (DONE), a failed worker (ERROR: its loop has returned) and a forked child (no
+        worker thread of its own) are EXITED."""
         if self.pid != os.getpid() or self.thread is None:
             self.ctl[0] = EXITED
-        elif _get(self.ctl) == REQUEST:
-            self._result()
+            return
+        s = _get(self.ctl)
+        if s == REQUEST:
+            self._result()              # -> IDLE (or raises the worker's error)
+        elif s == DONE:
+            _set(self.ctl, IDLE)
+        elif s == ERROR:
+            self.error = None
+            self.ctl[0] = EXITED
 
     def submit(self, QE, QDE, h: float, g):
         self._settle()

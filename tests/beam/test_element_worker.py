@@ -69,6 +69,22 @@ def test_uncollected_result_then_next_request(paper):
     w.submit(*inputs[0], kw["h"], kw["g"])          # result never collected
     Ms, Fs = w.submit(*inputs[1], kw["h"], kw["g"])()
     assert _same((Ms, Fs), _direct(batch, kw, *inputs[1]))
+    assert w.starts == 1
+
+
+def test_result_left_unread_then_next_request(paper):
+    """The worker has finished (DONE) and nobody read it: the next request goes to the same
+    worker (a second thread on the same mailbox would race it)."""
+    _, batch, kw, inputs, _ = paper
+    w = element_worker.ElementWorker(batch, *inputs[0][0].shape)
+    w.submit(*inputs[0], kw["h"], kw["g"])
+    deadline = time.monotonic() + 10.0
+    while w.ctl[0] != element_worker.DONE and time.monotonic() < deadline:
+        time.sleep(0.001)
+    assert w.ctl[0] == element_worker.DONE
+    Ms, Fs = w.submit(*inputs[1], kw["h"], kw["g"])()
+    assert _same((Ms, Fs), _direct(batch, kw, *inputs[1]))
+    assert w.starts == 1 and w.thread.is_alive()
 
 
 def test_worker_exits_when_idle_and_is_restarted(paper):
