@@ -668,15 +668,20 @@ class ElementBatch:
         return self.key == (tuple(id(el.q_xi) for el in elements)
                             + tuple(id(el.q_sub) for el in elements))
 
+    def element_arguments(self) -> tuple:
+        """The batch kernels' per-plan arguments after the states: (n, the basis tables, the
+        reference bases, i_s1, rhoA, Jrot, D per element) -- also the element worker's
+        (:mod:`sim_core.beam.element_worker`)."""
+        return (self.n, *self.tables, self.bases, self.i_s1, self.rhoAs, self.Jrots, self.Ds)
+
     def __call__(self, QE, QDE, h, g, cstep=_CSTEP):
         """(Me (E, nq, nq), Fe (E, nq)) at the rows of QE, QDE (real, C-contiguous).  No
         finite check here (it reads numpy's error state, which is per thread): the caller
         checks with ``cardan_compiled.check_finite``."""
         grav = np.ascontiguousarray(g, dtype=float)
         return _compiled_mass_force_batch(
-            QE, QDE, self.n, *self.tables, self.bases, self.i_s1, self.rhoAs, self.Jrots,
-            self.Ds, float(h), grav, self.inertia, self.elasticity, bool(np.any(grav != 0.0)),
-            float(cstep), _NO_ACC)
+            QE, QDE, *self.element_arguments(), float(h), grav, self.inertia, self.elasticity,
+            bool(np.any(grav != 0.0)), float(cstep), _NO_ACC)
 
     def differences(self, QE, QDE, QDDE, HQ, HQD, h, g, cstep=_CSTEP):
         """(d(F - M qdd)/dq, dF/dq_dot) (E, nq, nq) of every element by forward differences
@@ -684,9 +689,8 @@ class ElementBatch:
         as in __call__)."""
         grav = np.ascontiguousarray(g, dtype=float)
         return _compiled_differences_batch(
-            QE, QDE, QDDE, HQ, HQD, self.n, *self.tables, self.bases, self.i_s1, self.rhoAs,
-            self.Jrots, self.Ds, float(h), grav, self.inertia, self.elasticity,
-            bool(np.any(grav != 0.0)), float(cstep), _NO_ACC)
+            QE, QDE, QDDE, HQ, HQD, *self.element_arguments(), float(h), grav, self.inertia,
+            self.elasticity, bool(np.any(grav != 0.0)), float(cstep), _NO_ACC)
 
 
 def effect_parameters(effects, section):

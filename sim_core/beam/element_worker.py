@@ -27,8 +27,10 @@ word hands them over (acquire/release atomics; compare-and-swap where both threa
 A forked child gets its own worker (the parent's thread does not exist there: the process id
 is checked at every post).  Where numba, the atomics or ``usleep`` are not available
 (``AVAILABLE`` False) the model keeps the thread pool (``Model.element_spin``).
-``tests/beam/test_element_worker.py`` checks the results against the direct batch call (bitwise)
-and the hand-over states (exit after idling and restart, a result left unread, a second model).
+``tests/beam/test_element_worker.py`` checks the results against the direct batch call (to
+round-off) on every hand-over path: consecutive requests, a request not collected or a result
+not read before the next one (still one worker thread), exit after idling and restart, a forked
+child, and the model's right-hand side with and without the worker.
 """
 
 from __future__ import annotations
@@ -186,9 +188,9 @@ class ElementWorker:
 
     def _start(self) -> None:
         b = self.batch
-        args = (self.ctl, self.QE, self.QDE, self.Ms, self.Fs, self.par, b.n, *b.tables,
-                b.bases, b.i_s1, b.rhoAs, b.Jrots, b.Ds, b.inertia, b.elasticity,
-                element_compiled._CSTEP, element_compiled._NO_ACC)
+        args = (self.ctl, self.QE, self.QDE, self.Ms, self.Fs, self.par,
+                *b.element_arguments(), b.inertia, b.elasticity, element_compiled._CSTEP,
+                element_compiled._NO_ACC)
 
         def run():
             try:

@@ -5,10 +5,11 @@ outputs in a mailbox handed over by one atomic state word.  So its result must e
 call to round-off (1e-12 of the largest entry; the same call twice differs by ~2e-16 where BLAS
 sums in another order on differently aligned arrays), for every hand-over path: consecutive
 requests (the mailbox is reused), a request whose result was never collected before the next
-one, a worker that exited after idling and is started again, a forked child (the parent's
-thread does not exist there), and the model's right-hand side with and without it.  A stale or half-written result (the previous
-state's matrices, a missing acquire/release) differs from the direct call by orders of
-magnitude more (the states differ by 1e-3 m, 0.1 m/s).
+one or a result never read (one worker thread serves both), a worker that exited after idling
+and is started again, a forked child (the parent's thread does not exist there), and the model's
+right-hand side with and without it.  A stale or half-written result (the previous state's
+matrices, a missing acquire/release) differs from the direct call by orders of magnitude more
+(the states differ by 1e-3 m, 0.1 m/s).
 """
 
 import multiprocessing
