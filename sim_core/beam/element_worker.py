@@ -39,13 +39,14 @@ import ctypes
 import os
 import platform
 import threading
+import time
 
 import numpy as np
 
 from . import cardan_compiled, element_compiled
 
 IDLE, REQUEST, DONE, EXITED, ERROR = 0, 1, 2, 3, 4
-SPIN = 20000            # pause iterations after a request before sleeping (~1 ms)
+SPIN_S = 5e-3           # seconds of spinning after a request before sleeping
 SLEEP_US = 200          # microseconds per sleeping poll
 POLLS = 5000            # sleeping polls before the worker exits (~1 s idle)
 
@@ -116,11 +117,9 @@ def _loop(ctl, QE, QDE, Ms, Fs, par, n, t0, t1, t2, t3, t4, t5, t6, t7, bases, i
         if _load_acquire(ctl, 0) == REQUEST:
             grav = par[1:4].copy()
             gravity = grav[0] != 0.0 or grav[1] != 0.0 or grav[2] != 0.0
-            M, F = element_compiled._compiled_mass_force_batch(
-                QE, QDE, n, t0, t1, t2, t3, t4, t5, t6, t7, bases, i_s1, rhoAs, Jrots, Ds,
-                par[0], grav, inertia, elasticity, gravity, cstep, no_acc)
-            Ms[...] = M
-            Fs[...] = F
+            element_compiled._compiled_mass_force_batch_into(
+                Ms, Fs, QE, QDE, n, t0, t1, t2, t3, t4, t5, t6, t7, bases, i_s1, rhoAs, Jrots,
+                Ds, par[0], grav, inertia, elasticity, gravity, cstep, no_acc)
             _store_release(ctl, 0, DONE)
             idle = 0
         elif idle < spin:
@@ -131,6 +130,13 @@ def _loop(ctl, QE, QDE, Ms, Fs, par, n, t0, t1, t2, t3, t4, t5, t6, t7, bases, i
             _usleep(ctl[3])
             if idle >= spin + polls and _compare_and_swap(ctl, 0, IDLE, EXITED):
                 return
+
+
+def _pause_loop(n):
+    """n spin-wait hints (to time them: :func:`spin_iterations`)."""
+    for _ in range(n):
+        _cpu_pause()
+    return n
 
 
 def _wait(ctl, spins):
@@ -163,6 +169,31 @@ if AVAILABLE:
     _post = _jit(_post)
     _set = _jit(_set)
     _get = _jit(_get)
+    _pause_loop = _jit(_pause_loop)
+
+_PAUSE_RATE: list[float] = []        # spin-wait hints per second on this machine (measured once)
+
+
+def spin_iterations(seconds: float) -> int:
+    """Spin-wait iterations that last about ``seconds``: the x86 ``pause`` takes ~10 cycles on
+    older cores and ~140 on newer ones, so the worker's spin is set in time, from the rate
+    measured once per process (the fastest of three 2 ms rounds)."""
+    if not _PAUSE_RATE:
+        _pause_loop(10)                       # compiled / loaded before timing
+        n, best = 1000, 0.0
+        while True:                           # ~2 ms per round
+            t0 = time.perf_counter()
+            _pause_loop(n)
+            dt = time.perf_counter() - t0
+            if dt > 2e-3:
+                break
+            n *= 4
+        for _ in range(3):
+            t0 = time.perf_counter()
+            _pause_loop(n)
+            best = max(best, n / max(time.perf_counter() - t0, 1e-9))
+        _PAUSE_RATE.append(best)
+    return max(int(seconds * _PAUSE_RATE[0]), 1)
 
 
 class ElementWorker:
@@ -171,11 +202,11 @@ class ElementWorker:
     (Ms (E, nq, nq), Fs (E, nq)): the mailbox's arrays, valid until the next submit."""
 
     def __init__(self, batch: "element_compiled.ElementBatch", E: int, nq: int,
-                 spin: int = SPIN, polls: int = POLLS, sleep_us: int = SLEEP_US):
+                 spin: int | None = None, polls: int = POLLS, sleep_us: int = SLEEP_US):
         self.batch = batch
         self.ctl = np.zeros(8, dtype=np.int64)
         self.ctl[0] = EXITED
-        self.ctl[1:4] = spin, polls, sleep_us
+        self.ctl[1:4] = spin_iterations(SPIN_S) if spin is None else spin, polls, sleep_us
         self.QE = np.zeros((E, nq))
         self.QDE = np.zeros((E, nq))
         self.Ms = np.zeros((E, nq, nq))
