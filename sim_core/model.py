@@ -18,6 +18,7 @@ from typing import Callable, Sequence
 import numpy as np
 import scipy.linalg as sla
 
+from . import saddle_point_compiled
 from .beam import cardan_compiled, element_compiled, element_worker
 from .assembly_compiled import scatter_add, scatter_add_blocks
 from .beam.moving_node_beam import Beam
@@ -95,6 +96,11 @@ class Model:
     # 1.46 -> 1.39 ms per right-hand side, interleaved A/B 2026-11-24; its result arrays are the
     # worker's mailbox, valid until the next batch is started); False: the thread pool
     element_spin: bool = True
+    # with element_spin and kkt_blocks: add each element into M_r and factor its block as soon
+    # as the worker publishes it, while the worker computes the next elements
+    # (saddle_point_compiled.kkt_factor_pipelined); False: wait for the whole batch, then
+    # assemble and factor (the reference)
+    kkt_pipeline: bool = True
 
     def __post_init__(self):
         self.offsets = np.cumsum([0] + [b.n_coords for b in self.beams])[:-1]
@@ -272,13 +278,15 @@ class Model:
             pe.add(t, Q, Qd, M, F)
         return M, F
 
-    def _scatter_local_terms(self, t, Q, Qd, M, F, red, sg, Qdd_p=None, elements=None) -> list:
+    def _scatter_local_terms(self, t, Q, Qd, M, F, red, sg, Qdd_p=None, elements=None,
+                             defer: bool = False) -> list:
         """Add every element's, point load's and local point effect's (Me, Fe) into (M, F)
         through the coordinate map (red, sg) (:func:`assembly_compiled.scatter_add`); with
         ``Qdd_p`` the force is F - M Qdd_p.  Returns the point effects without a local form
         (``local(t, Q, Qd, mass) -> (idx, Me, Fe)``), for the caller to add on full arrays,
         and whether a point effect's mass couples two beams (elements never do).  ``elements``:
-        the element batch if already started (:meth:`_element_blocks_started`)."""
+        the element batch if already started (:meth:`_element_blocks_started`); ``defer``: leave
+        it out (the caller adds it, :meth:`_reduced_mass_force_at`)."""
         mass = M is not None
         coupled = False
 
@@ -306,6 +314,8 @@ class Model:
                 put(idx, Me, Fe)
             else:
                 rest.append(pe)
+        if defer:
+            return rest, coupled
         if blocks is not None:                 # the batch (started above, maybe on the worker)
             Ms, Fs = blocks()
             if Qdd_p is not None or not scatter_add_blocks(M, F, red, sg, self._element_idx,
@@ -347,8 +357,8 @@ class Model:
             worker = self.__dict__.get("_spin_worker")
             if worker is None or worker.batch is not batch:
                 worker = self._spin_worker = element_worker.ElementWorker(batch, *QE.shape)
-            result = worker.submit(QE, QDE, kw["h"], kw["g"])
-            return lambda: _checked(result())
+            worker.submit(QE, QDE, kw["h"], kw["g"])
+            return _WorkerBatch(worker)
         return self._run(lambda: batch(QE, QDE, kw["h"], kw["g"]))
 
     def _element_differences_started(self, Q, Qd, Qdd, steps):
@@ -456,12 +466,18 @@ class Model:
         Q, Qd = self.full_state(t, z, zd)
         return self._reduced_mass_force_at(t, Q, Qd, self.A_pinv @ self._b(t, 2))
 
-    def _reduced_mass_force_at(self, t, Q, Qd, Qdd_p, blocks: bool = False, elements=None):
+    def _reduced_mass_force_at(self, t, Q, Qd, Qdd_p, blocks: bool = False, elements=None,
+                               pipeline: bool = False):
         """(M_r, F_r) at the full state; ``blocks``: and the reduced coordinates of each
         element's own coordinates (:meth:`_block_of`) where M_r is block-diagonal in them (no
         point effect's mass couples two of them), else None (for ``constraints.kkt_factor``).
-        ``elements``: the element batch if already started (:meth:`_element_blocks_started`)."""
+        ``elements``: the element batch if already started (:meth:`_element_blocks_started`).
+        ``pipeline`` (with ``blocks``): a fourth value, the element batch of the worker where it
+        is left for the caller to add (:func:`saddle_point_compiled.kkt_factor_pipelined`),
+        else None (then it is in M_r, F_r)."""
         if self._sel is None:
+            if pipeline:
+                return self._reduced_mass_force_at(t, Q, Qd, Qdd_p, blocks, elements) + (None,)
             if elements is not None:
                 elements()                      # not used on this path: wait for it
             M, F = self.mass_force(t, Q, Qd)
@@ -482,20 +498,27 @@ class Model:
         dt = np.result_type(Q, Qd, float)
         Mr = np.zeros((n, n), dtype=dt)
         Fr = np.zeros(n, dtype=dt)
-        rest, coupled = self._scatter_local_terms(t, Q, Qd, Mr, Fr, *red[:2],
-                                                  Qdd_p=Qdd_p if np.any(Qdd_p) else None,
-                                                  elements=elements)
+        Qdd_p = Qdd_p if np.any(Qdd_p) else None
+        defer = (pipeline and blocks and isinstance(elements, _WorkerBatch) and Qdd_p is None
+                 and dt == np.float64)
+        rest, coupled = self._scatter_local_terms(t, Q, Qd, Mr, Fr, *red[:2], Qdd_p=Qdd_p,
+                                                  elements=elements, defer=defer)
         if rest:
             N = self.n_coords
             M, F = np.zeros((N, N), dtype=dt), np.zeros(N, dtype=dt)
             for pe in rest:
                 pe.add(t, Q, Qd, M, F)
             Mr += M[np.ix_(rows, rows)] * sgn2
-            Fr += sgn * (F - M @ Qdd_p)[rows]
+            Fr += sgn * (F if Qdd_p is None else F - M @ Qdd_p)[rows]
             coupled = True                      # unknown where the mass went
+        if defer and coupled:                   # no blocks to factor early: add the batch now
+            Ms, Fs = elements()
+            scatter_add_blocks(Mr, Fr, red[0], red[1], self._element_idx, Ms, Fs)
+            defer = False
         if not blocks:
             return Mr, Fr
-        return Mr, Fr, (None if coupled else red[2])
+        out = Mr, Fr, (None if coupled else red[2])
+        return out + ((elements if defer else None),) if pipeline else out
 
     @property
     def n(self) -> int:
@@ -531,13 +554,18 @@ class Model:
                 except Exception:  # noqa: BLE001 - the constraint rows' error is the one raised
                     pass
             raise
-        Mr, Fr, blocks = self._reduced_mass_force_at(t, Q, Qd, Qdd_p, blocks=True,
-                                                     elements=elements)
+        pipeline = (self.kkt_pipeline and self.kkt_blocks and bool(self.multiplier_forces)
+                    and saddle_point_compiled.PIPELINE)
+        Mr, Fr, blocks, *deferred = self._reduced_mass_force_at(
+            t, Q, Qd, Qdd_p, blocks=True, elements=elements, pipeline=pipeline)
         xi1, xi2 = self.baumgarte
         c_rhs = c_rhs - J @ Qdd_p - 2.0 * xi1 * dphi - xi2 ** 2 * phi
         if not self.multiplier_forces:
             return kkt_accelerations(Mr, Fr, self._times_P(J), c_rhs)
-        solve = kkt_factor(Mr, self._times_P(J), blocks if self.kkt_blocks else None)
+        if deferred and deferred[0] is not None:
+            solve = self._pipelined_factor(Mr, Fr, self._times_P(J), blocks, deferred[0])
+        else:
+            solve = kkt_factor(Mr, self._times_P(J), blocks if self.kkt_blocks else None)
         if newton:
             return self._multiplier_newton(ats, solve, Fr, c_rhs)
         zdd, lam = solve(Fr, c_rhs)
@@ -549,6 +577,26 @@ class Model:
             if change < self.multiplier_tol:
                 break
         return zdd, lam
+
+    def _pipelined_factor(self, Mr, Fr, C, blocks, batch: "_WorkerBatch"):
+        """The saddle-point solve while the worker's element batch is added into (Mr, Fr)
+        block by block (:func:`saddle_point_compiled.kkt_factor_pipelined`); the whole
+        matrix's LU where a block is not positive definite (as :func:`kkt_factor`)."""
+        hit = self.__dict__.get("_block_of_element")
+        if hit is None or hit[0] is not blocks:
+            owner = self._block_of()[self._sel[0]]
+            block_of = np.full(len(self._element_idx), -1, dtype=np.int64)
+            q = 0
+            for e in range(len(block_of)):
+                if np.any(owner == e):
+                    block_of[e] = q
+                    q += 1
+            hit = self._block_of_element = (blocks, block_of)
+        red = self._red_map
+        solve, out = saddle_point_compiled.kkt_factor_pipelined(
+            Mr, Fr, C, blocks, batch.worker, red[0], red[1], self._element_idx, hit[1])
+        _checked(out)
+        return solve if solve is not None else kkt_factor(Mr, C, None)
 
     def _multiplier_newton(self, ats, solve, Fr, c_rhs):
         """Multiplier-dependent forces E g(lambda) on k coordinates (friction: the contact
@@ -693,6 +741,18 @@ def _element_worker() -> ThreadPoolExecutor:
     if not _WORKER or _WORKER[0][0] != os.getpid():
         _WORKER[:] = [(os.getpid(), ThreadPoolExecutor(1, thread_name_prefix="sim_core-elements"))]
     return _WORKER[0][1]
+
+
+class _WorkerBatch:
+    """The element batch posted to the persistent worker (:class:`element_worker.
+    ElementWorker`): call it to wait for (Ms, Fs) (finite-checked, as :func:`_checked`), or
+    hand ``worker`` to :func:`saddle_point_compiled.kkt_factor_pipelined`."""
+
+    def __init__(self, worker):
+        self.worker = worker
+
+    def __call__(self):
+        return _checked(self.worker.result())
 
 
 def _checked(out):

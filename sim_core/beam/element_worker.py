@@ -5,7 +5,7 @@ second thread while it forms the constraint rows and point effects on the callin
 Through a ``ThreadPoolExecutor`` each hand-over costs a queue put, a thread wake-up, the
 worker's Python prologue before the compiled batch releases the GIL (the caller yields the GIL
 for it, ``time.sleep(0)``: ~0.1 ms in cProfile, the queue put ~0.04 ms) and a second wake-up
-when the caller joins.  Without them the paper scene's right-hand side takes 1.39 instead of
+when the caller joins.  Without them the paper scene's right-hand side took 1.39 instead of
 1.46 ms (interleaved A/B, 8 sub-elements; the element batch itself then sets the pace).
 
 Here the worker is one compiled loop (numba, nogil) that never needs the GIL: the batch's
@@ -16,11 +16,18 @@ word hands them over (acquire/release atomics; compare-and-swap where both threa
   outputs written; the caller reads them and sets IDLE: they stay valid until it posts again,
   as the worker writes only on a REQUEST), EXITED (no worker thread: the next post
   starts one), ERROR (the worker raised; the caller re-raises).
-* The worker spins on the state word (x86 ``pause``) for ``spin`` iterations after its last
-  request (a few hundred microseconds: consecutive right-hand sides of an explicit step are
-  ~20-50 us apart), then polls with ``usleep(sleep_us)``; after ``polls`` such polls (~1 s) it
-  leaves IDLE -> EXITED by compare-and-swap and returns, so an idle model does not keep a
-  thread.  A caller that finds EXITED starts a new thread.
+* The worker spins on the state word (x86 ``pause``) for ``SPIN_S`` = 5 ms after its last
+  request, then polls with ``usleep(sleep_us)``; after ``polls`` such polls (~1 s) it leaves
+  IDLE -> EXITED by compare-and-swap and returns, so an idle model does not keep a thread.  A
+  caller that finds EXITED starts a new thread.  The spin is set in time, from the pause rate
+  measured once per process (:func:`spin_iterations`): a fixed 20 000 pauses lasted only
+  ~0.2 ms on the test machine (~25 cycles each), shorter than the ~0.6 ms from one batch's end
+  to the next right-hand side's post, so the worker was asleep at every post and woke up to
+  0.2 ms late (right-hand side 1.44 -> 1.30 ms, back to back).
+* The worker writes the elements one by one and publishes each (the ``PROGRESS`` word,
+  release): :meth:`ElementWorker.wait_element` lets the caller use element e while the later
+  ones are computed (:func:`sim_core.saddle_point_compiled.kkt_factor_pipelined` factors each
+  element's block of the saddle-point matrix meanwhile).
 * The caller waits for DONE spinning in compiled code too (without the GIL), checking that
   the worker thread is alive between rounds.
 
@@ -30,7 +37,8 @@ is checked at every post).  Where numba, the atomics or ``usleep`` are not avail
 ``tests/beam/test_element_worker.py`` checks the results against the direct batch call (to
 round-off) on every hand-over path: consecutive requests, a request not collected or a result
 not read before the next one (still one worker thread), exit after idling and restart, a forked
-child, and the model's right-hand side with and without the worker.
+child, the elements published one by one, and the model's right-hand side with and without the
+worker.
 """
 
 from __future__ import annotations
@@ -46,6 +54,7 @@ import numpy as np
 from . import cardan_compiled, element_compiled
 
 IDLE, REQUEST, DONE, EXITED, ERROR = 0, 1, 2, 3, 4
+PROGRESS = 4            # ctl word: elements of the current request written so far
 SPIN_S = 5e-3           # seconds of spinning after a request before sleeping
 SLEEP_US = 200          # microseconds per sleeping poll
 POLLS = 5000            # sleeping polls before the worker exits (~1 s idle)
@@ -117,9 +126,14 @@ def _loop(ctl, QE, QDE, Ms, Fs, par, n, t0, t1, t2, t3, t4, t5, t6, t7, bases, i
         if _load_acquire(ctl, 0) == REQUEST:
             grav = par[1:4].copy()
             gravity = grav[0] != 0.0 or grav[1] != 0.0 or grav[2] != 0.0
-            element_compiled._compiled_mass_force_batch_into(
-                Ms, Fs, QE, QDE, n, t0, t1, t2, t3, t4, t5, t6, t7, bases, i_s1, rhoAs, Jrots,
-                Ds, par[0], grav, inertia, elasticity, gravity, cstep, no_acc)
+            for e in range(QE.shape[0]):    # element by element, each one published
+                M, F = element_compiled._compiled_mass_force(
+                    QE[e], QDE[e], n, t0, t1, t2, t3, t4, t5, t6, t7, bases[e], i_s1,
+                    rhoAs[e], Jrots[e], Ds[e], par[0], grav, inertia, elasticity, gravity, True,
+                    cstep, no_acc)
+                Ms[e] = M
+                Fs[e] = F
+                _store_release(ctl, PROGRESS, e + 1)
             _store_release(ctl, 0, DONE)
             idle = 0
         elif idle < spin:
@@ -137,6 +151,15 @@ def _pause_loop(n):
     for _ in range(n):
         _cpu_pause()
     return n
+
+
+def _wait_progress(ctl, e, spins):
+    """Spin until element e is written (True) or ``spins`` rounds have passed (False)."""
+    for _ in range(spins):
+        if _load_acquire(ctl, PROGRESS) > e:
+            return True
+        _cpu_pause()
+    return False
 
 
 def _wait(ctl, spins):
@@ -166,6 +189,7 @@ if AVAILABLE:
     _jit = cardan_compiled.numba.njit(cache=True, nogil=True)
     _loop = _jit(_loop)
     _wait = _jit(_wait)
+    _wait_progress = _jit(_wait_progress)
     _post = _jit(_post)
     _set = _jit(_set)
     _get = _jit(_get)
@@ -258,10 +282,26 @@ class ElementWorker:
         self.QDE[...] = QDE
         self.par[0] = h
         self.par[1:4] = g
+        self.ctl[PROGRESS] = 0              # published by the post's release below
         if not _post(self.ctl):          # EXITED (IDLE otherwise, after _settle)
             self.ctl[0] = REQUEST
             self._start()
         return self._result
+
+    def wait_element(self, e: int) -> None:
+        """Wait until element e of the posted request is written (Ms[e], Fs[e]; the rest of
+        the request may still run: :meth:`_result` collects it)."""
+        while not _wait_progress(self.ctl, e, 1 << 16):
+            s = _get(self.ctl)
+            if s == ERROR:
+                self._result()            # raises the worker's error
+            if not self.thread.is_alive() and s == REQUEST:
+                self.ctl[0] = EXITED      # pragma: no cover - the thread died without ERROR
+                raise RuntimeError("element worker thread ended without a result")
+
+    def result(self):
+        """Wait for the posted request: (Ms, Fs), the mailbox's arrays."""
+        return self._result()
 
     def _result(self):
         while True:

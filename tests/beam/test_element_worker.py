@@ -141,3 +141,19 @@ def test_model_rhs_with_and_without_the_worker(paper):
     assert m.__dict__.get("_spin_worker") is not None        # the worker path was taken
     for a, b in zip(out[True], out[False]):
         assert np.all(np.isfinite(a)) and _same([a], [b])
+
+
+def test_elements_are_published_one_by_one(paper):
+    """The worker publishes each element as it is written (its progress word, read by the
+    pipelined factorisation): after wait_element(e) element e is the direct batch's, before
+    the whole request is collected."""
+    _, batch, kw, inputs, _ = paper
+    w = element_worker.ElementWorker(batch, *inputs[0][0].shape)
+    ref = _direct(batch, kw, *inputs[1])
+    w.submit(*inputs[0], kw["h"], kw["g"])()
+    w.submit(*inputs[1], kw["h"], kw["g"])
+    for e in range(inputs[1][0].shape[0]):
+        w.wait_element(e)
+        assert _same((w.Ms[e], w.Fs[e]), (ref[0][e], ref[1][e]))
+    Ms, Fs = w.result()
+    assert _same((Ms, Fs), ref) and w.starts == 1

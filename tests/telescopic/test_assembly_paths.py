@@ -430,3 +430,111 @@ def test_compiled_point_effects_equal_their_local_blocks(state):
     finally:
         m.point_effects_compiled = True
     np.testing.assert_allclose(m.rhs(t, y), ref, rtol=0, atol=1e-9 * np.abs(ref).max())
+
+
+def _pipeline_or_skip(m):
+    from sim_core.beam import element_worker
+    if not (saddle_point_compiled.PIPELINE and m.element_thread and m.element_spin
+            and element_worker.AVAILABLE):
+        pytest.skip("no compiled element worker: no pipelined factorisation")
+
+
+def test_pipelined_factor_equals_assembly_then_factor(state, monkeypatch):
+    """Each element added into M_r and its block factored as the worker publishes it
+    (saddle_point_compiled.kkt_factor_pipelined) is the same arithmetic as assembling the
+    whole batch first and then factoring (Model.kkt_pipeline = False, the reference), apart
+    from the order in which the border's Schur complement is summed: the right-hand sides agree
+    to round-off (1e-12 of the largest entry; a missing element or block would be O(1)), and
+    the pipelined path is the one taken."""
+    ts, z, zd = state
+    m = ts.model
+    _pipeline_or_skip(m)
+    calls = []
+    real = saddle_point_compiled.kkt_factor_pipelined
+
+    def counted(*a, **k):
+        calls.append(1)
+        return real(*a, **k)
+    monkeypatch.setattr(saddle_point_compiled, "kkt_factor_pipelined", counted)
+    rng = np.random.default_rng(11)
+    for k in range(3):
+        y = np.concatenate([z + 1e-4 * rng.standard_normal(m.n_dof),
+                            0.05 * rng.standard_normal(m.n_dof)])
+        out = {}
+        for flag in (False, True):
+            m.kkt_pipeline = flag
+            m.__dict__.pop("_g_warm", None)        # the same friction-Newton start
+            try:
+                out[flag] = m.rhs(0.3 + 0.1 * k, y)
+            finally:
+                m.kkt_pipeline = True
+        assert np.all(np.isfinite(out[True]))
+        np.testing.assert_allclose(out[True], out[False], rtol=0,
+                                   atol=1e-12 * np.abs(out[False]).max())
+    assert len(calls) == 3
+
+
+def test_pipelined_factor_falls_back_where_a_block_is_not_definite(state):
+    """A block that is not positive definite (here: a large negative mass put on one element's
+    own coordinates before the batch is added) stops the elimination, but every element is
+    still added: (M_r, F_r) equal the assembled ones, and Model._pipelined_factor solves with
+    the whole matrix's LU."""
+    ts, z, zd = state
+    m = ts.model
+    _pipeline_or_skip(m)
+    t = 0.3
+    Q, Qd = m.full_state(t, z, zd)
+    Qdd_p = m.A_pinv @ m._b(t, 2)
+    Mr_ref, Fr_ref, blocks = m._reduced_mass_force_at(t, Q, Qd, Qdd_p, blocks=True)
+    elements = m._element_blocks_started(t, Q, Qd)
+    Mr, Fr, blocks2, deferred = m._reduced_mass_force_at(t, Q, Qd, Qdd_p, blocks=True,
+                                                         elements=elements, pipeline=True)
+    assert deferred is elements and blocks2 is blocks
+    b = blocks[0]
+    push = -1e3 * np.abs(Mr_ref).max() * np.eye(len(b))
+    Mr[np.ix_(b, b)] += push
+    _, J, _, c = constraint_terms(m.nonlinear, t, Q, Qd)
+    C = J @ m.P
+    solve = m._pipelined_factor(Mr, Fr, C, blocks, deferred)
+    Mr[np.ix_(b, b)] -= push
+    scale = np.abs(Mr_ref).max()
+    np.testing.assert_allclose(Mr, Mr_ref, rtol=0, atol=1e-12 * scale)
+    np.testing.assert_allclose(Fr, Fr_ref, rtol=0, atol=1e-12 * np.abs(Fr_ref).max())
+    Mr_bad = Mr_ref.copy()
+    Mr_bad[np.ix_(b, b)] += push
+    assert saddle_point_compiled.kkt_factor_blocks(Mr_bad, C, blocks) is None
+    ref = kkt_factor(Mr_bad, C)(Fr_ref, c)
+    got = solve(Fr_ref, c)
+    for a, r in zip(got, ref):
+        np.testing.assert_allclose(a, r, rtol=0, atol=1e-9 * np.abs(r).max())
+
+
+def test_pipeline_adds_the_batch_at_once_where_a_point_mass_couples_two_elements(state):
+    """With a point effect's mass across two elements' own coordinates there are no blocks to
+    factor early: the batch is added before _reduced_mass_force_at returns (no deferred
+    batch), equal to the assembly without the pipeline."""
+    ts, z, zd = state
+    m = ts.model
+    _pipeline_or_skip(m)
+    owner = m._block_of()
+    a = int(np.flatnonzero(owner == 0)[0])
+    b = int(np.flatnonzero(owner == 1)[0])
+
+    class Lumped:
+        def local(self, t, Q, Qd, mass=True):
+            return np.array([a, b]), (np.eye(2) if mass else None), np.zeros(2)
+
+    t = 0.3
+    Q, Qd = m.full_state(t, z, zd)
+    Qdd_p = m.A_pinv @ m._b(t, 2)
+    m.point_effects.append(Lumped())
+    try:
+        Mr0, Fr0, _ = m._reduced_mass_force_at(t, Q, Qd, Qdd_p, blocks=True)
+        elements = m._element_blocks_started(t, Q, Qd)
+        Mr, Fr, blocks, deferred = m._reduced_mass_force_at(
+            t, Q, Qd, Qdd_p, blocks=True, elements=elements, pipeline=True)
+    finally:
+        m.point_effects.pop()
+    assert blocks is None and deferred is None
+    np.testing.assert_allclose(Mr, Mr0, rtol=0, atol=1e-12 * np.abs(Mr0).max())
+    np.testing.assert_allclose(Fr, Fr0, rtol=0, atol=1e-12 * np.abs(Fr0).max())
