@@ -479,31 +479,21 @@ def _add_translational_mass(Me, Jrs, X, wl, rhoA, na, i_s1):
             Me[i_s1 + cc, i_s1 + dd] += Kss[cc, dd]
 
 
-def _mass_force_batch_into(Ms, Fs, QE, QDE, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos,
-                           q_drows, bases, i_s1, rhoAs, Jrots, Ds, h, grav, inertia, elasticity,
-                           gravity, cstep, no_acc):
+def _mass_force_batch(QE, QDE, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_drows,
+                      bases, i_s1, rhoAs, Jrots, Ds, h, grav, inertia, elasticity, gravity, cstep,
+                      no_acc):
     """_mass_force of E elements with the same tables (rows of QE, QDE; per element the
-    reference basis, rhoA, Jrot, D) into Ms (E, nq, nq), Fs (E, nq) (the element worker's
-    mailbox: no batch-sized allocation, whose fresh pages cost more than the copy)."""
-    for e in range(QE.shape[0]):
+    reference basis, rhoA, Jrot, D): (Me (E, nq, nq), Fe (E, nq)) in one call."""
+    E, nq = QE.shape
+    Ms = np.empty((E, nq, nq))
+    Fs = np.empty((E, nq))
+    for e in range(E):
         M, F = _compiled_mass_force(QE[e], QDE[e], n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w,
                                     q_pos, q_drows, bases[e], i_s1, rhoAs[e], Jrots[e],
                                     Ds[e], h, grav, inertia, elasticity, gravity, True, cstep,
                                     no_acc)
         Ms[e] = M
         Fs[e] = F
-
-
-def _mass_force_batch(QE, QDE, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_drows,
-                      bases, i_s1, rhoAs, Jrots, Ds, h, grav, inertia, elasticity, gravity, cstep,
-                      no_acc):
-    """(Me (E, nq, nq), Fe (E, nq)) of _mass_force_batch_into in new arrays."""
-    E, nq = QE.shape
-    Ms = np.empty((E, nq, nq))
-    Fs = np.empty((E, nq))
-    _compiled_mass_force_batch_into(Ms, Fs, QE, QDE, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w,
-                                    q_pos, q_drows, bases, i_s1, rhoAs, Jrots, Ds, h, grav,
-                                    inertia, elasticity, gravity, cstep, no_acc)
     return Ms, Fs
 
 
@@ -591,7 +581,6 @@ if AVAILABLE:
     _gram = _jit(_gram_syrk if _SYRK else _gram_dot)
     _add_translational_mass = _jit(_add_translational_mass)
     _compiled_mass_force = _jit(_mass_force)
-    _compiled_mass_force_batch_into = _jit(_mass_force_batch_into)
     _compiled_mass_force_batch = _jit(_mass_force_batch)
     _compiled_differences_batch = _jit(_differences_batch)
 

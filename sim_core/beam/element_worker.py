@@ -146,11 +146,15 @@ def _loop(ctl, QE, QDE, Ms, Fs, par, n, t0, t1, t2, t3, t4, t5, t6, t7, bases, i
                 return
 
 
-def _pause_loop(n):
-    """n spin-wait hints (to time them: :func:`spin_iterations`)."""
+def _pause_loop(ctl, n):
+    """n rounds of the worker's idle spin (an acquire load of the state word and a spin-wait
+    hint: what :func:`spin_iterations` times; the load keeps the loop where there is no
+    ``pause`` to emit)."""
+    s = 0
     for _ in range(n):
+        s += _load_acquire(ctl, 0)
         _cpu_pause()
-    return n
+    return s
 
 
 def _wait_progress(ctl, e, spins):
@@ -199,22 +203,23 @@ _PAUSE_RATE: list[float] = []        # spin-wait hints per second on this machin
 
 
 def spin_iterations(seconds: float) -> int:
-    """Spin-wait iterations that last about ``seconds``: the x86 ``pause`` takes ~10 cycles on
-    older cores and ~140 on newer ones, so the worker's spin is set in time, from the rate
-    measured once per process (the fastest of three 2 ms rounds)."""
+    """Idle-spin rounds of the worker that last about ``seconds``: the x86 ``pause`` takes ~10
+    cycles on older cores and ~140 on newer ones (~25 on the test machine), so the worker's spin
+    is set in time, from the rate measured once per process (the fastest of three ~2 ms
+    rounds)."""
     if not _PAUSE_RATE:
-        _pause_loop(10)                       # compiled / loaded before timing
+        ctl = np.zeros(1, dtype=np.int64)
+        _pause_loop(ctl, 10)                  # compiled / loaded before timing
         n, best = 1000, 0.0
-        while True:                           # ~2 ms per round
+        while n < (1 << 34):                  # ~2 ms per round
             t0 = time.perf_counter()
-            _pause_loop(n)
-            dt = time.perf_counter() - t0
-            if dt > 2e-3:
+            _pause_loop(ctl, n)
+            if time.perf_counter() - t0 > 2e-3:
                 break
             n *= 4
         for _ in range(3):
             t0 = time.perf_counter()
-            _pause_loop(n)
+            _pause_loop(ctl, n)
             best = max(best, n / max(time.perf_counter() - t0, 1e-9))
         _PAUSE_RATE.append(best)
     return max(int(seconds * _PAUSE_RATE[0]), 1)
