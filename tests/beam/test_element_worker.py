@@ -42,6 +42,10 @@ def paper():
     ix = m._element_idx
     inputs = [(np.ascontiguousarray(Q[ix]), np.ascontiguousarray(Qd[ix])) for Q, Qd in states]
     z0, _ = m.reduced_state(0.0, ts.Q0, np.zeros_like(ts.Q0))
+    # the direct batch compiled (or loaded) before any worker starts: on a fresh install its
+    # first call takes seconds, longer than a worker idles before it exits, and a test that
+    # counts one worker thread would then see a second one
+    _direct(batch, kw, *inputs[0])
     return m, batch, kw, inputs, z0
 
 
