@@ -488,10 +488,15 @@ class Model:
         rows, sgn, sgn2 = self._sel
         red = self.__dict__.get("_red_map")
         if red is None:
+            # (reduced index, sign) of each coordinate, the blocks (each element's own reduced
+            # coordinates, where it has any) and each element's block or -1
             owner = self._block_of()[rows]
-            own = [np.flatnonzero(owner == e) for e in range(max(owner.max() + 1, 0))]
+            own = [np.flatnonzero(owner == e) for e in range(sum(len(b.elements)
+                                                                 for b in self.beams))]
+            has = np.array([len(b) > 0 for b in own], dtype=bool)
             red = self._red_map = (np.full(self.n_coords, -1), np.zeros(self.n_coords),
-                                   [b for b in own if len(b)])
+                                   [b for b in own if len(b)],
+                                   np.where(has, np.cumsum(has) - 1, -1).astype(np.int64))
             red[0][rows] = np.arange(len(rows))
             red[1][rows] = sgn
         n = len(rows)
@@ -582,19 +587,9 @@ class Model:
         """The saddle-point solve while the worker's element batch is added into (Mr, Fr)
         block by block (:func:`saddle_point_compiled.kkt_factor_pipelined`); the whole
         matrix's LU where a block is not positive definite (as :func:`kkt_factor`)."""
-        hit = self.__dict__.get("_block_of_element")
-        if hit is None or hit[0] is not blocks:
-            owner = self._block_of()[self._sel[0]]
-            block_of = np.full(len(self._element_idx), -1, dtype=np.int64)
-            q = 0
-            for e in range(len(block_of)):
-                if np.any(owner == e):
-                    block_of[e] = q
-                    q += 1
-            hit = self._block_of_element = (blocks, block_of)
-        red = self._red_map
+        red = self._red_map                     # blocks is red[2], each element's block red[3]
         solve, out = saddle_point_compiled.kkt_factor_pipelined(
-            Mr, Fr, C, blocks, batch.worker, red[0], red[1], self._element_idx, hit[1])
+            Mr, Fr, C, blocks, batch.worker, red[0], red[1], self._element_idx, red[3])
         _checked(out)
         return solve if solve is not None else kkt_factor(Mr, C, None)
 

@@ -303,12 +303,12 @@ if AVAILABLE:
     _factor_block = _jit(_factor_block)
     _factor_border = _jit(_factor_border)
     _factor_compiled = _jit(_factor)
-PIPELINE = AVAILABLE and element_worker.AVAILABLE and assembly_compiled.AVAILABLE
-if PIPELINE:
-    _scatter_factor = _jit(_scatter_factor)
     _once = _jit(_once)
     _times_Mr = _jit(_times_Mr)
     _solve_compiled = _jit(_solve)
+PIPELINE = AVAILABLE and element_worker.AVAILABLE and assembly_compiled.AVAILABLE
+if PIPELINE:
+    _scatter_factor = _jit(_scatter_factor)
 
 
 _LAYOUT: list = []          # [(n, the blocks list, its arrays, layout)]: the last one used

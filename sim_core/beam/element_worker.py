@@ -274,7 +274,7 @@ class ElementWorker:
             return
         s = _get(self.ctl)
         if s == REQUEST:
-            self._result()              # -> IDLE (or raises the worker's error)
+            self.result()               # -> IDLE (or raises the worker's error)
         elif s == DONE:
             _set(self.ctl, IDLE)
         elif s == ERROR:
@@ -291,33 +291,30 @@ class ElementWorker:
         if not _post(self.ctl):          # EXITED (IDLE otherwise, after _settle)
             self.ctl[0] = REQUEST
             self._start()
-        return self._result
+        return self.result
 
     def wait_element(self, e: int) -> None:
         """Wait until element e of the posted request is written (Ms[e], Fs[e]; the rest of
-        the request may still run: :meth:`_result` collects it)."""
+        the request may still run: :meth:`result` collects it)."""
         while not _wait_progress(self.ctl, e, 1 << 16):
-            s = _get(self.ctl)
-            if s == ERROR:
-                self._result()            # raises the worker's error
-            if not self.thread.is_alive() and s == REQUEST:
-                self.ctl[0] = EXITED      # pragma: no cover - the thread died without ERROR
-                raise RuntimeError("element worker thread ended without a result")
+            self._check(_get(self.ctl))
 
     def result(self):
         """Wait for the posted request: (Ms, Fs), the mailbox's arrays."""
-        return self._result()
-
-    def _result(self):
         while True:
             s = _wait(self.ctl, 1 << 16)
             if s == DONE:             # the worker writes the mailbox only on a REQUEST,
                 _set(self.ctl, IDLE)      # so IDLE already: it may exit while idle
                 return self.Ms, self.Fs
-            if s == ERROR:
-                exc, self.error = self.error, None
-                self.ctl[0] = EXITED
-                raise RuntimeError("element worker failed") from exc
-            if not self.thread.is_alive() and _get(self.ctl) == REQUEST:
-                self.ctl[0] = EXITED      # pragma: no cover - the thread died without ERROR
-                raise RuntimeError("element worker thread ended without a result")
+            self._check(s)
+
+    def _check(self, s) -> None:
+        """Between waiting rounds (``s``: the state word): raise the worker's error (ERROR),
+        or that its thread ended with the request open."""
+        if s == ERROR:
+            exc, self.error = self.error, None
+            self.ctl[0] = EXITED
+            raise RuntimeError("element worker failed") from exc
+        if not self.thread.is_alive() and _get(self.ctl) == REQUEST:
+            self.ctl[0] = EXITED      # pragma: no cover - the thread died without ERROR
+            raise RuntimeError("element worker thread ended without a result")
