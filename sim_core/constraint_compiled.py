@@ -10,8 +10,9 @@ functions) and, column by column in the structured Jacobian (:mod:`sim_core.stat
 ~1200 such evaluations per Jacobian.  Here the same rows are one compiled program:
 
 * every point once, at the complex-step state Q + i h Q_dot (h = 1e-20): r, its Jacobian,
-  the Cardan angles and theirs (:func:`sim_core.beam.point_compiled._point_full`, the same
-  kernel as the Python path), and J Q_dot;
+  the Cardan angles and theirs on the point's own columns (its element's coordinates and
+  its moving coordinate: :func:`sim_core.beam.point_compiled._point_local`, the same kernel
+  as the Python path), and J Q_dot;
 * per constraint its rows: a difference of components of two points (point or angle
   coincidence, a point fixed in space), a distance |r_a - r_b| (cylinders) or a sum of
   distances (rope); the value g and the Jacobian G = g_Q are the real parts, the quadratic
@@ -44,18 +45,18 @@ DIFF_R, DIFF_PSI, DISTANCE, ROPE = 0, 1, 2, 3
 
 def _eval_point(p, Qc, Qd, N, p_fixed, p_r, p_beam, p_sidx, p_sfix, p_off, p_hasoff,
                 beam_first, beam_count, el_idx, el_right, n, D_all, pow_p, pow_t, bases, i_s1,
-                R, J, PSI, JP, VR, VP):
-    """Point p at the complex state Qc (= Q + i h Q_dot) into R, J (3, N), PSI, JP, VR = J Qd,
-    VP = JP Qd (complex); returns the finite-check sum."""
+                R, J, PSI, JP, VR, VP, PC, PN):
+    """Point p at the complex state Qc (= Q + i h Q_dot) into R, PSI, VR = J Qd, VP = JP Qd
+    (complex) and its Jacobians on its own columns: J[p, :, k], JP[p, :, k] = d/dQ[PC[p, k]]
+    for k < PN[p] (its element's coordinates, then its moving coordinate's column, which may
+    repeat one of them: the rows add); returns the finite-check sum."""
     if p_fixed[p]:
         for i in range(3):
             R[p, i] = p_r[p, i]
             PSI[p, i] = 0.0
             VR[p, i] = 0.0
             VP[p, i] = 0.0
-            for k in range(N):
-                J[p, i, k] = 0.0
-                JP[p, i, k] = 0.0
+        PN[p] = 0
         return 0.0
     b = p_beam[p]
     sidx = p_sidx[p]
@@ -67,27 +68,41 @@ def _eval_point(p, Qc, Qd, N, p_fixed, p_r, p_beam, p_sidx, p_sfix, p_off, p_has
             e = e0 + k
             break
     o_sec = p_off[p] if p_hasoff[p] else p_off[p, :0]
-    r, Jf, ang, Jpf, total = _point_full(Qc, el_idx[e], sidx, s, o_sec, N, n, D_all, pow_p,
-                                         pow_t, bases[e], i_s1)
+    idx = el_idx[e]
+    nq = idx.shape[0]
+    r, Jr, ang, Jpsi, rp, psi_p, total = _point_local(Qc, idx, s, o_sec, n, D_all, pow_p,
+                                                      pow_t, bases[e], i_s1)
+    for k in range(nq):
+        PC[p, k] = idx[k]
+    PN[p] = nq
+    if sidx >= 0:
+        PC[p, nq] = sidx
+        PN[p] = nq + 1
     for i in range(3):
         R[p, i] = r[i]
         PSI[p, i] = ang[i]
         vr = 0.0j
         vp = 0.0j
-        for k in range(N):
-            J[p, i, k] = Jf[i, k]
-            JP[p, i, k] = Jpf[i, k]
-            vr += Jf[i, k] * Qd[k]
-            vp += Jpf[i, k] * Qd[k]
+        for k in range(nq):
+            J[p, i, k] = Jr[i, k]
+            JP[p, i, k] = Jpsi[i, k]
+            vr += Jr[i, k] * Qd[idx[k]]
+            vp += Jpsi[i, k] * Qd[idx[k]]
+        if sidx >= 0:
+            J[p, i, nq] = rp[i]
+            JP[p, i, nq] = psi_p[i]
+            vr += rp[i] * Qd[sidx]
+            vp += psi_p[i] * Qd[sidx]
         VR[p, i] = vr
         VP[p, i] = vp
     return total
 
 
 def _eval_constraint(c, N, c_kind, c_row0, c_nrow, c_comp, c_pts, c_npts, R, J, PSI, JP, VR,
-                     VP, g, Gc, quad_c):
-    """Rows of constraint c from the point arrays: g (real), Gc (complex Jacobian rows),
-    quad_c = Gc Q_dot (complex; its imaginary part / h is g_QQ[Q_dot, Q_dot])."""
+                     VP, PC, PN, g, Gc, quad_c):
+    """Rows of constraint c from the point arrays: g (real), Gc (complex Jacobian rows, the
+    points' own columns added in), quad_c = Gc Q_dot (complex; its imaginary part / h is
+    g_QQ[Q_dot, Q_dot])."""
     kind = c_kind[c]
     r0 = c_row0[c]
     for i in range(c_nrow[c]):
@@ -104,13 +119,13 @@ def _eval_constraint(c, N, c_kind, c_row0, c_nrow, c_comp, c_pts, c_npts, R, J, 
             row = r0 + i
             val = X[a, comp]
             v = VX[a, comp]
-            for k in range(N):
-                Gc[row, k] = JX[a, comp, k]
+            for k in range(PN[a]):
+                Gc[row, PC[a, k]] += JX[a, comp, k]
             if bb >= 0:
                 val = val - X[bb, comp]
                 v = v - VX[bb, comp]
-                for k in range(N):
-                    Gc[row, k] -= JX[bb, comp, k]
+                for k in range(PN[bb]):
+                    Gc[row, PC[bb, k]] -= JX[bb, comp, k]
             g[row] = val.real
             quad_c[row] = v
         return
@@ -131,8 +146,10 @@ def _eval_constraint(c, N, c_kind, c_row0, c_nrow, c_comp, c_pts, c_npts, R, J, 
         for i in range(3):
             u = d[i] / nn
             v += u * (VR[pb, i] - VR[pa, i])
-            for k in range(N):
-                Gc[r0, k] += u * (J[pb, i, k] - J[pa, i, k])
+            for k in range(PN[pb]):
+                Gc[r0, PC[pb, k]] += u * J[pb, i, k]
+            for k in range(PN[pa]):
+                Gc[r0, PC[pa, k]] -= u * J[pa, i, k]
     g[r0] = total.real
     quad_c[r0] = v
 
@@ -149,20 +166,23 @@ def _program_terms(Q, Qd, P, N, p_fixed, p_r, p_beam, p_sidx, p_sfix, p_off, p_h
     PSI = np.empty((P, 3), dtype=np.complex128)
     VR = np.empty((P, 3), dtype=np.complex128)
     VP = np.empty((P, 3), dtype=np.complex128)
-    J = np.empty((P, 3, N), dtype=np.complex128)
-    JP = np.empty((P, 3, N), dtype=np.complex128)
+    L = el_idx.shape[1] + 1                  # a point's columns: its element's and its s
+    J = np.zeros((P, 3, L), dtype=np.complex128)
+    JP = np.zeros((P, 3, L), dtype=np.complex128)
+    PC = np.zeros((P, L), dtype=np.int64)
+    PN = np.zeros(P, dtype=np.int64)
     total = 0.0
     for p in range(P):
         total += _eval_point(p, Qc, Qd, N, p_fixed, p_r, p_beam, p_sidx, p_sfix, p_off,
                              p_hasoff, beam_first, beam_count, el_idx, el_right, n, D_all,
-                             pow_p, pow_t, bases, i_s1, R, J, PSI, JP, VR, VP)
+                             pow_p, pow_t, bases, i_s1, R, J, PSI, JP, VR, VP, PC, PN)
     g = np.zeros(m)
     Gc = np.zeros((m, N), dtype=np.complex128)
     quad_c = np.zeros(m, dtype=np.complex128)
     for c in range(c_kind.shape[0]):
         _eval_constraint(c, N, c_kind, c_row0, c_nrow, c_comp, c_pts, c_npts, R, J, PSI, JP,
-                         VR, VP, g, Gc, quad_c)
-    return g, Gc, quad_c, Qc, R, J, PSI, JP, VR, VP, total
+                         VR, VP, PC, PN, g, Gc, quad_c)
+    return g, Gc, quad_c, Qc, R, J, PSI, JP, VR, VP, PC, PN, total
 
 
 def _terms(Q, Qd, P, N, p_fixed, p_r, p_beam, p_sidx, p_sfix, p_off, p_hasoff, beam_first,
@@ -170,7 +190,7 @@ def _terms(Q, Qd, P, N, p_fixed, p_r, p_beam, p_sidx, p_sfix, p_off, p_hasoff, b
            c_nrow, c_comp, c_pts, c_npts, m, cstep, rate_part):
     """(g, G (m, N), quad (m,), G_rate (m, N) or (0, N), finite-check sum): G = Re Gc,
     quad = Im(quad_c) / h, G_rate = Im(Gc) / h (with ``rate_part``)."""
-    g, Gc, quad_c, _, _, _, _, _, _, _, total = _program_terms(
+    g, Gc, quad_c, _, _, _, _, _, _, _, _, _, total = _program_terms(
         Q, Qd, P, N, p_fixed, p_r, p_beam, p_sidx, p_sfix, p_off, p_hasoff, beam_first,
         beam_count, el_idx, el_right, n, D_all, pow_p, pow_t, bases, i_s1, c_kind, c_row0,
         c_nrow, c_comp, c_pts, c_npts, m, cstep)
@@ -194,7 +214,7 @@ def _columns(Q, Qd, Qdd, lam, b0, bd, bdd, xi1, xi2, cols, steps, P, N, p_fixed,
     r2 = G Q_ddot - (b_ddot - g_QQ[Q_dot, Q_dot] - 2 xi1 (G Q_dot - b_dot) - xi2^2 (g - b))
     (m,): (dR1 (N, ncols), dR2 (m, ncols), finite-check sum).  ``p_deps`` (P, N) bool: the
     coordinates each point depends on at Q."""
-    g0, Gc0, qc0, Qc, R, J, PSI, JP, VR, VP, total = _program_terms(
+    g0, Gc0, qc0, Qc, R, J, PSI, JP, VR, VP, PC, PN, total = _program_terms(
         Q, Qd, P, N, p_fixed, p_r, p_beam, p_sidx, p_sfix, p_off, p_hasoff, beam_first,
         beam_count, el_idx, el_right, n, D_all, pow_p, pow_t, bases, i_s1, c_kind, c_row0,
         c_nrow, c_comp, c_pts, c_npts, m, cstep)
@@ -213,6 +233,7 @@ def _columns(Q, Qd, Qdd, lam, b0, bd, bdd, xi1, xi2, cols, steps, P, N, p_fixed,
     dR2 = np.zeros((m, ncol))
     # scratch copies of the point arrays and rows, restored after each column
     R1, J1, PSI1, JP1, VR1, VP1 = R.copy(), J.copy(), PSI.copy(), JP.copy(), VR.copy(), VP.copy()
+    PC1, PN1 = PC.copy(), PN.copy()
     g1 = g0.copy()
     Gc1 = Gc0.copy()
     qc1 = qc0.copy()
@@ -237,7 +258,7 @@ def _columns(Q, Qd, Qdd, lam, b0, bd, bdd, xi1, xi2, cols, steps, P, N, p_fixed,
                 total += _eval_point(p, Qc, Qd, N, p_fixed, p_r, p_beam, p_sidx, p_sfix,
                                      p_off, p_hasoff, beam_first, beam_count, el_idx,
                                      el_right, n, D_all, pow_p, pow_t, bases, i_s1, R1, J1,
-                                     PSI1, JP1, VR1, VP1)
+                                     PSI1, JP1, VR1, VP1, PC1, PN1)
         for c in range(K):
             uses[c] = False
             for q in range(c_npts[c]):
@@ -246,7 +267,7 @@ def _columns(Q, Qd, Qdd, lam, b0, bd, bdd, xi1, xi2, cols, steps, P, N, p_fixed,
             if not uses[c]:
                 continue
             _eval_constraint(c, N, c_kind, c_row0, c_nrow, c_comp, c_pts, c_npts, R1, J1,
-                             PSI1, JP1, VR1, VP1, g1, Gc1, qc1)
+                             PSI1, JP1, VR1, VP1, PC1, PN1, g1, Gc1, qc1)
             for i in range(c_row0[c], c_row0[c] + c_nrow[c]):
                 li = lam[i] / h
                 gq = 0.0
@@ -269,14 +290,17 @@ def _columns(Q, Qd, Qdd, lam, b0, bd, bdd, xi1, xi2, cols, steps, P, N, p_fixed,
                     PSI1[p, i] = PSI[p, i]
                     VR1[p, i] = VR[p, i]
                     VP1[p, i] = VP[p, i]
-                    for k in range(N):
+                    for k in range(PN[p]):
                         J1[p, i, k] = J[p, i, k]
                         JP1[p, i, k] = JP[p, i, k]
+                PN1[p] = PN[p]
+                for k in range(PN[p]):
+                    PC1[p, k] = PC[p, k]
     return dR1, dR2, total
 
 
 if AVAILABLE:
-    _point_full = point_compiled._compiled_point_full
+    _point_local = point_compiled._compiled_point_local
     _jit = cardan_compiled.numba.njit(cache=True, nogil=True)
     _eval_point = _jit(_eval_point)
     _eval_constraint = _jit(_eval_constraint)

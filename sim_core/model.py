@@ -10,6 +10,7 @@ constraint drift.  Constraint reactions are recovered as A^T lambda = M Q_ddot -
 from __future__ import annotations
 
 import os
+import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -362,10 +363,11 @@ class Model:
         return self._run(lambda: batch(QE, QDE, kw["h"], kw["g"]))
 
     def _element_differences_started(self, Q, Qd, Qdd, steps):
-        """Start the structured Jacobian's element columns as one compiled batch
-        (:meth:`element_compiled.ElementBatch.differences`; on the worker thread with
-        ``element_thread``) and return a function that waits for them: per element
-        (d(F - M Qdd)/dq, dF/dq_dot), in the order of :meth:`element_indices`.  ``steps(x)``:
+        """Start the structured Jacobian's element columns, element by element
+        (:meth:`element_compiled.ElementBatch.differences`; with ``element_thread`` on the
+        worker thread, and the calling thread takes the rest when it waits) and return a
+        function that waits for them: per element (d(F - M Qdd)/dq, dF/dq_dot), in the order
+        of :meth:`element_indices`.  ``steps(x)``:
         the forward-difference steps of a coordinate vector.  None where the batch does not
         cover the model."""
         plan = self._element_batch_plan(Q, Qd)
@@ -376,7 +378,36 @@ class Model:
         QE, QDE, QDDE = Q[ix], Qd[ix], np.ascontiguousarray(Qdd[ix], dtype=float)
         HQ = np.stack([steps(q) for q in QE])
         HQD = np.stack([steps(q) for q in QDE])
-        return self._run(lambda: batch.differences(QE, QDE, QDDE, HQ, HQD, kw["h"], kw["g"]))
+        E, nq = QE.shape
+        DP, DR = np.empty((E, nq, nq)), np.empty((E, nq, nq))
+
+        def element(e):
+            r = slice(e, e + 1)
+            DP[r], DR[r] = batch.differences(QE[r], QDE[r], QDDE[r], HQ[r], HQD[r], kw["h"],
+                                             kw["g"], element=e)
+        shared = _SharedElements(E, element)
+        if not self.element_thread:
+            shared.run()
+            return lambda: _checked((DP, DR))
+        future = _element_worker().submit(shared.run)
+        if self.element_yield:
+            time.sleep(0)       # hand the GIL over now (see element_yield)
+
+        def finish():
+            # the calling thread, its own pieces done, takes the elements the worker has not
+            # started (~10 ms each at 8 sub-elements: the two threads end together)
+            try:
+                shared.run()
+            except BaseException:
+                shared.stop()
+                try:
+                    future.result()
+                except Exception:  # noqa: BLE001 - the calling thread's error is the one raised
+                    pass
+                raise
+            future.result()                 # the worker's error, if any
+            return _checked((DP, DR))
+        return finish
 
     def _run(self, job):
         """job() on the element worker thread with ``element_thread`` (a function that waits
@@ -736,6 +767,34 @@ def _element_worker() -> ThreadPoolExecutor:
     if not _WORKER or _WORKER[0][0] != os.getpid():
         _WORKER[:] = [(os.getpid(), ThreadPoolExecutor(1, thread_name_prefix="sim_core-elements"))]
     return _WORKER[0][1]
+
+
+class _SharedElements:
+    """Elements 0..E-1 handed out one at a time to whichever thread asks next (``run``: take
+    and compute until none is left), so that the worker and the calling thread share a batch
+    whatever the calling thread's own work took."""
+
+    def __init__(self, E: int, work):
+        self.E, self.work = E, work
+        self._next = 0
+        self._lock = threading.Lock()
+
+    def _take(self) -> int:
+        with self._lock:
+            e = self._next
+            self._next += 1
+        return e
+
+    def run(self) -> None:
+        e = self._take()
+        while e < self.E:
+            self.work(e)
+            e = self._take()
+
+    def stop(self) -> None:
+        """No further element is handed out (the one being computed finishes)."""
+        with self._lock:
+            self._next = self.E
 
 
 class _WorkerBatch:

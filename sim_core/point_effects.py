@@ -96,6 +96,14 @@ class RopeDrive:
             return k * (ell - self.L0 - 0.5 * self.slack_width)
         return k * self.slack_width * 0.5 * x * x
 
+    def tension_rate(self, ell):
+        """dT/dl (N/m) of :meth:`tension`."""
+        k = self.EA / self.L0
+        if self.bilateral:
+            return k
+        x = (ell - self.L0) / self.slack_width
+        return 0.0 if x <= 0 else (k if x >= 1 else k * x)
+
     def local(self, t, Q, Qd, mass=True):
         """(idx, None, Fe) on the coordinates where dl/dQ is not zero (those of the rope's
         points)."""
@@ -150,6 +158,42 @@ class CompiledPointEffects:
             row += m
         program = program_for(cons)
         return None if program is None else CompiledPointEffects(effects, rows, program)
+
+    def jacobian(self, Q, Qd, Qdd, steps):
+        """(d/dQ, d/dQ_dot) (N, N) of the effects' F - M Q_ddot at frozen Q_ddot (their pieces
+        of the structured Jacobian, :mod:`sim_core.state_jacobian`).  Each is G^T mu over its
+        rows: payload mu = m (g - J Q_ddot - J_dot Q_dot), rope mu = -T(l) (G its row dl/dQ),
+        so d/dQ_j = (dG/dQ_j)^T mu + G^T dmu/dQ_j: the first term and d(G Q_ddot + J_dot Q_dot)
+        /dQ_j from the program's forward-difference columns (steps ``steps(x)``, as the Python
+        pieces), the rope's dmu/dQ_j = -T'(l) G[j] analytic; d/dQ_dot: the payload's
+        -2 m G^T g_QQ Q_dot (the program's rate part), the ropes' none."""
+        prog = self.program
+        N = prog.N
+        g, G, quad, G_rate = prog.terms(Q, Qd, rate_part=True)
+        mu = np.zeros(prog.m)
+        for pe, sl in zip(self.effects, self.rows):
+            if isinstance(pe, PointMass):
+                mu[sl] = -pe.mass * (G[sl] @ Qdd + quad[sl])
+                if pe.gravity is not None:
+                    mu[sl] += pe.mass * pe.gravity
+            else:
+                mu[sl.start] = -pe.tension(float(g[sl.start]))
+        deps = prog.dependencies(Q)
+        cols = np.flatnonzero(deps.any(axis=0))
+        zero = np.zeros(prog.m)
+        d1, d2 = prog.columns(Q, Qd, Qdd, mu, zero, zero, zero, 0.0, 0.0, cols,
+                              steps(Q[cols]), deps)
+        dQ = np.zeros((N, N))
+        dQd = np.zeros((N, N))
+        dQ[:, cols] = d1
+        for pe, sl in zip(self.effects, self.rows):
+            if isinstance(pe, PointMass):
+                dQ[:, cols] -= pe.mass * (G[sl].T @ d2[sl])
+                dQd -= 2.0 * pe.mass * (G[sl].T @ G_rate[sl])
+            else:
+                row = G[sl.start]
+                dQ[:, cols] -= pe.tension_rate(float(g[sl.start])) * np.outer(row, row[cols])
+        return dQ, dQd
 
     def local(self, Q, Qd, mass=True) -> list:
         """[(idx, Me or None, Fe)] of every effect, in order (as its ``local``)."""

@@ -1,15 +1,16 @@
 """Compiled (numba) block elimination of the saddle-point system over diagonal blocks of M_r.
 
 The same algorithm as :func:`sim_core.constraints._kkt_factor_blocks` (the reference and the
-fallback): Cholesky of each block A_i = M_r[b_i, b_i] (``Model``: an element's own
-coordinates), B_i = [M_r[b_i, r], C[:, b_i]^T], the Schur complement S = D - sum_i B_i^T
-A_i^-1 B_i of the border (coordinates in no block and the multipliers; LU with partial
-pivoting), and every solve followed by one step of iterative refinement on the whole system
-(its residual from the blocks, their border columns and the border rows: the non-zero parts
-of M_r only; a right-hand side that is zero on a block, e.g. a unit load on a border
-coordinate, skips that block's solve).  As one compiled factorisation and one compiled solve
+fallback): Cholesky of each block A_i = M_r[b_i, b_i] = L_i L_i^T (``Model``: an element's
+own coordinates), B_i = [M_r[b_i, r], C[:, b_i]^T], W_i = L_i^-1 B_i (one triangular solve;
+A_i^-1 B_i would take two), the Schur complement S = D - sum_i W_i^T W_i of the border
+(coordinates in no block and the multipliers; LU with partial pivoting), and every solve
+followed by one step of iterative refinement on the whole system (its residual from the
+blocks, their border columns and the border rows: the non-zero parts of M_r only; a
+right-hand side that is zero on a block, e.g. a unit load on a border coordinate, skips that
+block's forward solve).  As one compiled factorisation and one compiled solve
 the ~30 LAPACK and numpy calls of the Python version (each with its call overhead; 0.4 ms +
-0.25 ms per telescopic right-hand side at 8 sub-elements) become two.  LAPACK (dpotrf, dpotrs, dgetrf,
+0.25 ms per telescopic right-hand side at 8 sub-elements) become two.  LAPACK (dpotrf, dtrtrs, dgetrf,
 dgetrs of scipy's ``cython_lapack``) is called through external symbols, as
 :mod:`sim_core.beam.element_compiled` calls dsyrk, so the functions stay cacheable.
 ``tests/telescopic/test_assembly_paths.py`` checks both against the LU of the whole matrix.
@@ -20,7 +21,7 @@ element is added -- while the worker computes the later elements.  At 8 sub-elem
 calling thread finishes its own share (constraint rows, friction maps, point effects) when
 five of the six elements are done, factors their blocks while the sixth is computed, and is
 left with one block, the border and its LU: right-hand side 1.27 -> 1.17 ms (interleaved A/B).
-The border's Schur complement is then summed as (-sum_i B_i^T Y_i) + D instead of D - sum_i
+The border's Schur complement is then summed as (-sum_i W_i^T W_i) + D instead of D - sum_i
 (round-off; the tests compare the two paths to 1e-12).
 """
 
@@ -47,6 +48,7 @@ if cardan_compiled.AVAILABLE:
         _dpotrs = _external("dpotrs", 8)     # uplo, n, nrhs, a, lda, b, ldb, info
         _dgetrf = _external("dgetrf", 6)     # m, n, a, lda, ipiv, info
         _dgetrs = _external("dgetrs", 9)     # trans, n, nrhs, a, lda, ipiv, b, ldb, info
+        _dtrtrs = _external("dtrtrs", 10)    # uplo, trans, diag, n, nrhs, a, lda, b, ldb, info
         AVAILABLE = True
     except Exception:        # pragma: no cover - scipy without cython_lapack
         AVAILABLE = False
@@ -69,31 +71,35 @@ def _chol(A, n):
     return info[0]
 
 
-def _chol_solve(Af, n, X):
+def _tri_solve(Af, n, X, transpose):
     """In place: the first n columns of X (nrhs, ldx) C order = the Fortran (ldx, nrhs)
-    right-hand sides, solved with the factor of _chol (leading dimension Af.shape[0])."""
+    right-hand sides, solved with the triangle of _chol's factor: L^-1 X, or L^-T X with
+    ``transpose`` (A = L L^T; leading dimension Af.shape[0])."""
     nrhs = X.shape[0]
     uplo = np.array([ord("L")], dtype=np.uint8)
+    trans = np.array([ord("T") if transpose else ord("N")], dtype=np.uint8)
+    diag = np.array([ord("N")], dtype=np.uint8)
     nn = _i32(n)
     nr = _i32(nrhs)
     lda = _i32(Af.shape[0])
     ldx = _i32(X.shape[1])
     info = _i32(0)
     if nrhs > 0:
-        _dpotrs(uplo.ctypes, nn.ctypes, nr.ctypes, Af.ctypes, lda.ctypes, X.ctypes, ldx.ctypes,
-                info.ctypes)
+        _dtrtrs(uplo.ctypes, trans.ctypes, diag.ctypes, nn.ctypes, nr.ctypes, Af.ctypes,
+                lda.ctypes, X.ctypes, ldx.ctypes, info.ctypes)
 
 
 def _workspace(k, L, nr, m, n):
-    """(facs, As, Bs, Ys (k, L, .), S (nb, nb) zero, Mrr (nr, n)) of one factorisation."""
+    """(facs, As, Bs, Ws (k, L, .), S (nb, nb) zero, Mrr (nr, n)) of one factorisation."""
     nb = nr + m
     return (np.zeros((k, L, L)), np.zeros((k, L, L)), np.zeros((k, L, nb)), np.zeros((k, L, nb)),
             np.zeros((nb, nb)), np.empty((nr, n)))
 
 
-def _factor_block(q, Mr, C, blocks, lens, r, facs, As, Bs, Ys, S):
-    """Block q: its Cholesky factor, B_q = [Mr[b_q, r], C[:, b_q]^T], Y_q = A_q^-1 B_q, and
-    S -= B_q^T Y_q; it reads only the rows b_q of Mr (complete once the element that owns
+def _factor_block(q, Mr, C, blocks, lens, r, facs, As, Bs, Ws, S):
+    """Block q: its Cholesky factor A_q = L_q L_q^T, B_q = [Mr[b_q, r], C[:, b_q]^T],
+    W_q = L_q^-1 B_q, and S -= W_q^T W_q (= B_q^T A_q^-1 B_q: one triangular solve instead of
+    A_q^-1 B_q's two); it reads only the rows b_q of Mr (complete once the element that owns
     them is added).  Returns LAPACK's info (0: positive definite)."""
     nr = r.shape[0]
     m = C.shape[0]
@@ -114,7 +120,7 @@ def _factor_block(q, Mr, C, blocks, lens, r, facs, As, Bs, Ys, S):
         for j in range(m):
             Bs[q, i, nr + j] = C[j, bi]
     # only the border columns that touch this block (a constraint row on other beams, a
-    # border coordinate not coupled to it: a zero column of B, hence of Y = A^-1 B)
+    # border coordinate not coupled to it: a zero column of B, hence of W = L^-1 B)
     act = np.empty(nb, dtype=np.int64)
     na = 0
     for j in range(nb):
@@ -124,17 +130,16 @@ def _factor_block(q, Mr, C, blocks, lens, r, facs, As, Bs, Ys, S):
                 na += 1
                 break
     L = facs.shape[1]
-    Yt = np.zeros((na, L))                   # Y^T in C order: the Fortran (L, na) block
-    Bt = np.empty((na, nq))
+    Yt = np.zeros((na, L))                   # W^T in C order: the Fortran (L, na) block
     for jj in range(na):
         for i in range(nq):
-            Bt[jj, i] = Bs[q, i, act[jj]]
-            Yt[jj, i] = Bt[jj, i]
-    _chol_solve(A, nq, Yt)
+            Yt[jj, i] = Bs[q, i, act[jj]]
+    _tri_solve(A, nq, Yt, False)
     for jj in range(na):
         for i in range(nq):
-            Ys[q, i, act[jj]] = Yt[jj, i]
-    P = np.dot(Bt, Yt[:, :nq].T.copy())      # B^T Y on the active columns
+            Ws[q, i, act[jj]] = Yt[jj, i]
+    Wa = Yt[:, :nq].copy()
+    P = np.dot(Wa, Wa.T)                     # W^T W on the active columns
     for a in range(na):
         for c in range(na):
             S[act[a], act[c]] -= P[a, c]
@@ -170,17 +175,17 @@ def _factor(Mr, C, blocks, lens, r):
     C^T, the blocks (for the residual), Mr's border rows); blocks padded to L (zero rows beyond
     a block's length)."""
     k, L = blocks.shape
-    facs, As, Bs, Ys, S, Mrr = _workspace(k, L, r.shape[0], C.shape[0], Mr.shape[0])
+    facs, As, Bs, Ws, S, Mrr = _workspace(k, L, r.shape[0], C.shape[0], Mr.shape[0])
     for q in range(k):
-        if _factor_block(q, Mr, C, blocks, lens, r, facs, As, Bs, Ys, S) != 0:
-            return False, facs, Bs, Ys, S, np.zeros(S.shape[0], dtype=np.int32), C.T.copy(), \
+        if _factor_block(q, Mr, C, blocks, lens, r, facs, As, Bs, Ws, S) != 0:
+            return False, facs, Bs, Ws, S, np.zeros(S.shape[0], dtype=np.int32), C.T.copy(), \
                 As, Mrr
     ok, St, piv, CT = _factor_border(Mr, C, r, S, Mrr)
-    return ok, facs, Bs, Ys, St, piv, CT, As, Mrr
+    return ok, facs, Bs, Ws, St, piv, CT, As, Mrr
 
 
 def _scatter_factor(ctl, start, spins, Mr, Fr, red, sg, IDX, Ms, Fs, block_of, C, blocks,
-                    lens, r, facs, As, Bs, Ys, S, failed):
+                    lens, r, facs, As, Bs, Ws, S, failed):
     """Pipelined with the element worker: for elements e = start, ... as the worker publishes
     them (``element_worker``'s progress word in ctl), add (Me, Fe) into (Mr, Fr) and factor the
     block e owns (:func:`_factor_block`), so the blocks are factored while the worker computes
@@ -195,14 +200,15 @@ def _scatter_factor(ctl, start, spins, Mr, Fr, red, sg, IDX, Ms, Fs, block_of, C
         assembly_compiled._scatter(Mr, Fr, red, sg, IDX[e], Ms[e], Fs[e], True)
         q = block_of[e]
         if q >= 0 and failed[0] == 0:
-            if _factor_block(q, Mr, C, blocks, lens, r, facs, As, Bs, Ys, S) != 0:
+            if _factor_block(q, Mr, C, blocks, lens, r, facs, As, Bs, Ws, S) != 0:
                 failed[0] = 1
     return E
 
 
-def _once(facs, Bs, Ys, St, piv, blocks, lens, r, F, c):
+def _once(facs, Bs, Ws, St, piv, blocks, lens, r, F, c):
     """One elimination solve: (z (n, nrhs), mu (m, nrhs)) of [[Mr, C^T], [C, 0]] [z; mu] =
-    [F; c]."""
+    [F; c]: per block v = L^-1 F_b, the border's g = F_r - sum W^T v, its LU solve w, and
+    z_b = L^-T (v - W w) (= A^-1 (F_b - B w))."""
     k, L = blocks.shape
     n, nrhs = F.shape
     nr = r.shape[0]
@@ -224,10 +230,10 @@ def _once(facs, Bs, Ys, St, piv, blocks, lens, r, F, c):
                 ut[j, i] = F[blocks[q, i], j]
                 if ut[j, i] != 0.0:
                     nonzero = True
-        if not nonzero:                          # u = A^-1 0 = 0 (e.g. a unit load on the
+        if not nonzero:                          # v = L^-1 0 = 0 (e.g. a unit load on the
             continue                             # border: the friction Newton's columns)
-        _chol_solve(facs[q], nq, ut)
-        gt -= np.dot(ut, Bs[q])                  # (B^T u)^T = u^T B; zero padding
+        _tri_solve(facs[q], nq, ut, False)
+        gt -= np.dot(ut, Ws[q])                  # (W^T v)^T = v^T W; zero padding
     trans = np.array([ord("N")], dtype=np.uint8)
     nn = _i32(nb)
     nr_ = _i32(nrhs)
@@ -241,11 +247,15 @@ def _once(facs, Bs, Ys, St, piv, blocks, lens, r, F, c):
     w = gt.T.copy()
     for q in range(k):
         nq = lens[q]
-        Yw = np.dot(Ys[q], w)                    # (L, nrhs)
+        Ww = np.dot(Ws[q], w)                    # (L, nrhs)
         ut = us[q]
         for i in range(nq):
             for j in range(nrhs):
-                z[blocks[q, i], j] = ut[j, i] - Yw[i, j]
+                ut[j, i] -= Ww[i, j]
+        _tri_solve(facs[q], nq, ut, True)
+        for i in range(nq):
+            for j in range(nrhs):
+                z[blocks[q, i], j] = ut[j, i]
     mu = np.empty((m, nrhs))
     for j in range(nrhs):
         for i in range(m):
@@ -283,12 +293,12 @@ def _times_Mr(As, Bs, Mrr, blocks, lens, r, z):
     return y
 
 
-def _solve(C, CT, facs, Bs, Ys, St, piv, blocks, lens, r, F, c, refine, As, Mrr):
-    z, mu = _once(facs, Bs, Ys, St, piv, blocks, lens, r, F, c)
+def _solve(C, CT, facs, Bs, Ws, St, piv, blocks, lens, r, F, c, refine, As, Mrr):
+    z, mu = _once(facs, Bs, Ws, St, piv, blocks, lens, r, F, c)
     if refine:
         rF = F - _times_Mr(As, Bs, Mrr, blocks, lens, r, z) - np.dot(CT, mu)
         rc = c - np.dot(C, z)
-        dz, dmu = _once(facs, Bs, Ys, St, piv, blocks, lens, r, rF, rc)
+        dz, dmu = _once(facs, Bs, Ws, St, piv, blocks, lens, r, rF, rc)
         z = z + dz
         mu = mu + dmu
     return z, mu
@@ -298,7 +308,7 @@ if AVAILABLE:
     _jit = cardan_compiled.numba.njit(cache=True, nogil=True)
     _i32 = _jit(_i32)
     _chol = _jit(_chol)
-    _chol_solve = _jit(_chol_solve)
+    _tri_solve = _jit(_tri_solve)
     _workspace = _jit(_workspace)
     _factor_block = _jit(_factor_block)
     _factor_border = _jit(_factor_border)
@@ -344,13 +354,13 @@ def kkt_factor_blocks(Mr, C, blocks, refine: bool = True):
     B, lens, r = _layout(n, blocks)
     Mr = np.ascontiguousarray(Mr, dtype=float)
     C = np.ascontiguousarray(C, dtype=float)
-    ok, facs, Bs, Ys, St, piv, CT, As, Mrr = _factor_compiled(Mr, C, B, lens, r)
+    ok, facs, Bs, Ws, St, piv, CT, As, Mrr = _factor_compiled(Mr, C, B, lens, r)
     if not ok:
         return None
-    return _solver(C, CT, facs, Bs, Ys, St, piv, B, lens, r, refine, As, Mrr)
+    return _solver(C, CT, facs, Bs, Ws, St, piv, B, lens, r, refine, As, Mrr)
 
 
-def _solver(C, CT, facs, Bs, Ys, St, piv, B, lens, r, refine, As, Mrr):
+def _solver(C, CT, facs, Bs, Ws, St, piv, B, lens, r, refine, As, Mrr):
     n, m = Mrr.shape[1], C.shape[0]            # Mrr: Mr's border rows (nr, n)
 
     def solve(Fr, c_rhs):
@@ -359,7 +369,7 @@ def _solver(C, CT, facs, Bs, Ys, St, piv, B, lens, r, refine, As, Mrr):
         vec = F.ndim == 1
         F2 = np.ascontiguousarray(F.reshape(n, -1))
         c2 = np.ascontiguousarray(c.reshape(m, -1))
-        z, mu = _solve_compiled(C, CT, facs, Bs, Ys, St, piv, B, lens, r, F2, c2, refine, As,
+        z, mu = _solve_compiled(C, CT, facs, Bs, Ws, St, piv, B, lens, r, F2, c2, refine, As,
                                 Mrr)
         return (z[:, 0], -mu[:, 0]) if vec else (z, -mu)
     return solve
@@ -378,12 +388,12 @@ def kkt_factor_pipelined(Mr, Fr, C, blocks, worker, red, sg, IDX, block_of,
     B, lens, r = _layout(n, blocks)
     C = np.ascontiguousarray(C, dtype=float)
     k, L = B.shape
-    facs, As, Bs, Ys, S, Mrr = _workspace(k, L, r.shape[0], C.shape[0], n)
+    facs, As, Bs, Ws, S, Mrr = _workspace(k, L, r.shape[0], C.shape[0], n)
     failed = np.zeros(1, dtype=np.int64)
     e, E = 0, IDX.shape[0]
     while e < E:
         e = _scatter_factor(worker.ctl, e, 1 << 16, Mr, Fr, red, sg, IDX, worker.Ms, worker.Fs,
-                            block_of, C, B, lens, r, facs, As, Bs, Ys, S, failed)
+                            block_of, C, B, lens, r, facs, As, Bs, Ws, S, failed)
         if e < E:
             worker.wait_element(e)          # checks the worker; raises where it failed
     out = worker.result()                   # the request is complete: collect it
@@ -392,4 +402,4 @@ def kkt_factor_pipelined(Mr, Fr, C, blocks, worker, red, sg, IDX, block_of,
     ok, St, piv, CT = _factor_border(Mr, C, r, S, Mrr)
     if not ok:
         return None, out
-    return _solver(C, CT, facs, Bs, Ys, St, piv, B, lens, r, refine, As, Mrr), out
+    return _solver(C, CT, facs, Bs, Ws, St, piv, B, lens, r, refine, As, Mrr), out

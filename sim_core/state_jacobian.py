@@ -129,7 +129,14 @@ def state_jacobian(model, t: float, y: np.ndarray, rel_step: float = REL_STEP,
             return F, None
         pieces.append((off + beam.index_map[e], np.zeros(0, int), point_load, None))
 
-    for pe in model.point_effects:         # payload, ropes: F_pe - M_pe Q_ddot
+    # payload and ropes in one compiled program (point_effects.CompiledPointEffects.jacobian)
+    # where it covers them, else as pieces below
+    pe_batch = None if central else model._compiled_point_effects()
+    if pe_batch is not None:
+        dQ, dQd = pe_batch.jacobian(Q, Qd, Qdd, lambda x: _steps(x, rel_step))
+        dR1[:, :N] += dQ
+        dR1[:, N:] += dQd
+    for pe in ([] if pe_batch is not None else model.point_effects):   # F_pe - M_pe Q_ddot
         def point_effect(Qx, Qdx, pe=pe):
             F = np.zeros(N)
             if hasattr(pe, "local"):           # a block on a few coordinates

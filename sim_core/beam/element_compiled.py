@@ -683,13 +683,18 @@ class ElementBatch:
             QE, QDE, *self.element_arguments(), float(h), grav, self.inertia, self.elasticity,
             bool(np.any(grav != 0.0)), float(cstep), _NO_ACC)
 
-    def differences(self, QE, QDE, QDDE, HQ, HQD, h, g, cstep=_CSTEP):
+    def differences(self, QE, QDE, QDDE, HQ, HQD, h, g, cstep=_CSTEP, element=None):
         """(d(F - M qdd)/dq, dF/dq_dot) (E, nq, nq) of every element by forward differences
         with the steps HQ, HQD (E, nq) at the rows of QE, QDE, QDDE (no finite check here,
-        as in __call__)."""
+        as in __call__); ``element``: the rows are this one element's alone (E = 1)."""
         grav = np.ascontiguousarray(g, dtype=float)
+        args = self.element_arguments()
+        if element is not None:             # its own rows of the per-element tables
+            e = slice(element, element + 1)
+            args = args[:-5] + (self.bases[e], self.i_s1, self.rhoAs[e], self.Jrots[e],
+                                self.Ds[e])
         return _compiled_differences_batch(
-            QE, QDE, QDDE, HQ, HQD, *self.element_arguments(), float(h), grav, self.inertia,
+            QE, QDE, QDDE, HQ, HQD, *args, float(h), grav, self.inertia,
             self.elasticity, bool(np.any(grav != 0.0)), float(cstep), _NO_ACC)
 
 

@@ -96,11 +96,11 @@ def _point(qe, s, n, D_all, pow_p, pow_t, basis, i_s1):
             frame[0].copy(), tmat[0].copy(), total)
 
 
-def _point_full(Q, idx, s_index, s, o_sec, N, n, D_all, pow_p, pow_t, basis, i_s1):
-    """(r, dr/dQ (3, N), angles, dangles/dQ (3, N), finite-check sum) of a material point on
-    the full coordinates: _point on the element's coordinates Q[idx], the rigid offset o_sec
-    (axial, lateral, vertical; empty: none) in the section frame, and the moving point's
-    s column (s_index >= 0).  The same algebra as the Python of
+def _point_local(Q, idx, s, o_sec, n, D_all, pow_p, pow_t, basis, i_s1):
+    """(r, J_r (3, nq), angles, J_psi (3, nq), r', psi', finite-check sum) of a material point
+    on its element's coordinates Q[idx]: _point with the rigid offset o_sec (axial, lateral,
+    vertical; empty: none) in the section frame; J_r, J_psi = d/dQ[idx] at fixed s, r', psi'
+    = d/ds (the column of a moving point's coordinate).  The same algebra as the Python of
     :func:`sim_core.constraints.material_point` (its reference path)."""
     dt = Q.dtype
     nq = idx.shape[0]
@@ -127,6 +127,17 @@ def _point_full(Q, idx, s_index, s, o_sec, N, n, D_all, pow_p, pow_t, basis, i_s
         J_r = J_r + np.dot(oxR, J_psi)
         rp = rp + np.dot(oxR, psi_prime)
         r = r + o
+    return r, J_r, angles, J_psi, rp, psi_prime, total
+
+
+def _point_full(Q, idx, s_index, s, o_sec, N, n, D_all, pow_p, pow_t, basis, i_s1):
+    """(r, dr/dQ (3, N), angles, dangles/dQ (3, N), finite-check sum) of a material point on
+    the full coordinates: :func:`_point_local` scattered, with the moving point's s column
+    (s_index >= 0)."""
+    dt = Q.dtype
+    nq = idx.shape[0]
+    r, J_r, angles, J_psi, rp, psi_prime, total = _point_local(
+        Q, idx, s, o_sec, n, D_all, pow_p, pow_t, basis, i_s1)
     J = np.zeros((3, N), dtype=dt)
     Jp = np.zeros((3, N), dtype=dt)
     for i in range(3):
@@ -141,7 +152,9 @@ def _point_full(Q, idx, s_index, s, o_sec, N, n, D_all, pow_p, pow_t, basis, i_s
 
 if AVAILABLE:
     _compiled_point = cardan_compiled.numba.njit(cache=True, nogil=True)(_point)
-    _point = _compiled_point                   # the callee of _point_full
+    _point = _compiled_point                   # the callee of _point_local
+    _compiled_point_local = cardan_compiled.numba.njit(cache=True, nogil=True)(_point_local)
+    _point_local = _compiled_point_local       # the callee of _point_full
     _compiled_point_full = cardan_compiled.numba.njit(cache=True, nogil=True)(_point_full)
 
 

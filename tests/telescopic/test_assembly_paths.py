@@ -538,3 +538,80 @@ def test_pipeline_adds_the_batch_at_once_where_a_point_mass_couples_two_elements
     assert blocks is None and deferred is None
     np.testing.assert_allclose(Mr, Mr0, rtol=0, atol=1e-12 * np.abs(Mr0).max())
     np.testing.assert_allclose(Fr, Fr0, rtol=0, atol=1e-12 * np.abs(Fr0).max())
+
+
+def test_compiled_point_effect_jacobian_equals_the_python_pieces(state):
+    """The structured Jacobian with the payload and ropes from their compiled program
+    (point_effects.CompiledPointEffects.jacobian: program columns, the ropes' T'(l) and the
+    payload's rate part analytic) against the Python pieces (forward differences of each
+    effect's ``local``): both are forward differences at the same steps, so they agree to the
+    differences' truncation and round-off, ~1e-8 of the column scale (sqrt(eps) ~ 1.5e-8;
+    measured 2.2e-8, asserted 1e-7).  That scale is the booms' stiffness, so the effects'
+    own pieces are checked too, against central differences of their ``local`` terms to
+    1e-6 of their scale (dropping the payload's inertia or rate term, or the rope's T'(l),
+    fails it)."""
+    from sim_core.point_effects import CompiledPointEffects
+    from sim_core.state_jacobian import _steps, state_jacobian
+    ts, z, zd = state
+    m = ts.model
+    if CompiledPointEffects.build(m.point_effects) is None:
+        pytest.skip("numba not installed: no compiled point effects")
+    y = np.concatenate([z, zd])
+    J_compiled = state_jacobian(m, 0.3, y)
+    m.point_effects_compiled = False
+    try:
+        J_python = state_jacobian(m, 0.3, y)
+    finally:
+        m.point_effects_compiled = True
+    scale = np.max(np.abs(J_python), axis=0)
+    np.testing.assert_allclose(J_compiled, J_python, rtol=0, atol=1e-7 * np.max(scale))
+    # the effects' own pieces against central differences of their summed local terms
+    # F - M Qdd (at the model's accelerations, so the payload's inertia term is in): central
+    # differences are O(h^2) accurate, the compiled forward ones O(h) ~ 1e-8 of the scale
+    Q, Qd = m.full_state(0.3, z, zd)
+    Qdd = m._lift(0.3, m.accelerations(0.3, z, zd), 2)
+    dQ, dQd = m._compiled_point_effects().jacobian(Q, Qd, Qdd, lambda x: _steps(x, 1.5e-8))
+
+    def pieces(Qx, Qdx):
+        F = np.zeros(len(Q))
+        for pe in m.point_effects:
+            idx, Me, Fe = pe.local(0.3, Qx, Qdx)
+            F[idx] += Fe if Me is None else Fe - Me @ Qdd[idx]
+        return F
+    cols = np.flatnonzero(np.abs(dQ).sum(axis=0) + np.abs(dQd).sum(axis=0))
+    for X, D in ((Q, dQ), (Qd, dQd)):
+        ref = np.empty((len(Q), len(cols)))
+        for k, j in enumerate(cols):
+            h = 1e-6 * max(abs(X[j]), 1.0)
+            xj = X[j]
+            X[j] = xj + h
+            up = pieces(Q, Qd)
+            X[j] = xj - h
+            lo = pieces(Q, Qd)
+            X[j] = xj
+            ref[:, k] = (up - lo) / (2 * h)
+        np.testing.assert_allclose(D[:, cols], ref, rtol=0, atol=1e-6 * np.abs(ref).max())
+
+
+def test_shared_elements_are_each_taken_once():
+    """The Jacobian's element columns are shared between the worker and the calling thread
+    (model._SharedElements): each element is computed exactly once whoever takes it, and after
+    ``stop`` no further one is handed out."""
+    import threading
+    from sim_core.model import _SharedElements
+    done, lock = [], threading.Lock()
+
+    def work(e):
+        with lock:
+            done.append(e)
+    shared = _SharedElements(50, work)
+    th = threading.Thread(target=shared.run)
+    th.start()
+    shared.run()
+    th.join()
+    assert sorted(done) == list(range(50))
+    done.clear()
+    shared = _SharedElements(5, work)
+    shared.stop()
+    shared.run()
+    assert done == []
