@@ -386,12 +386,11 @@ class Model:
             DP[r], DR[r] = batch.differences(QE[r], QDE[r], QDDE[r], HQ[r], HQD[r], kw["h"],
                                              kw["g"], element=e)
         shared = _SharedElements(E, element)
-        if not self.element_thread:
+
+        def job():
             shared.run()
-            return lambda: _checked((DP, DR))
-        future = _element_worker().submit(shared.run)
-        if self.element_yield:
-            time.sleep(0)       # hand the GIL over now (see element_yield)
+            return DP, DR
+        wait = self._run(job)                # at once without element_thread
 
         def finish():
             # the calling thread, its own pieces done, takes the elements the worker has not
@@ -401,12 +400,11 @@ class Model:
             except BaseException:
                 shared.stop()
                 try:
-                    future.result()
+                    wait()
                 except Exception:  # noqa: BLE001 - the calling thread's error is the one raised
                     pass
                 raise
-            future.result()                 # the worker's error, if any
-            return _checked((DP, DR))
+            return wait()                   # the worker's error, if any; finite-checked
         return finish
 
     def _run(self, job):

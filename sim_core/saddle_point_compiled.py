@@ -130,15 +130,15 @@ def _factor_block(q, Mr, C, blocks, lens, r, facs, As, Bs, Ws, S):
                 na += 1
                 break
     L = facs.shape[1]
-    Yt = np.zeros((na, L))                   # W^T in C order: the Fortran (L, na) block
+    Wt = np.zeros((na, L))                   # W^T in C order: the Fortran (L, na) block
     for jj in range(na):
         for i in range(nq):
-            Yt[jj, i] = Bs[q, i, act[jj]]
-    _tri_solve(A, nq, Yt, False)
+            Wt[jj, i] = Bs[q, i, act[jj]]
+    _tri_solve(A, nq, Wt, False)
     for jj in range(na):
         for i in range(nq):
-            Ws[q, i, act[jj]] = Yt[jj, i]
-    Wa = Yt[:, :nq].copy()
+            Ws[q, i, act[jj]] = Wt[jj, i]
+    Wa = Wt[:, :nq].copy()
     P = np.dot(Wa, Wa.T)                     # W^T W on the active columns
     for a in range(na):
         for c in range(na):
@@ -171,7 +171,7 @@ def _factor_border(Mr, C, r, S, Mrr):
 
 
 def _factor(Mr, C, blocks, lens, r):
-    """(ok, factors (k, L, L), B (k, L, nb), Y (k, L, nb), S's LU (nb, nb) Fortran, pivots,
+    """(ok, factors (k, L, L), B (k, L, nb), W (k, L, nb), S's LU (nb, nb) Fortran, pivots,
     C^T, the blocks (for the residual), Mr's border rows); blocks padded to L (zero rows beyond
     a block's length)."""
     k, L = blocks.shape
@@ -205,7 +205,7 @@ def _scatter_factor(ctl, start, spins, Mr, Fr, red, sg, IDX, Ms, Fs, block_of, C
     return E
 
 
-def _once(facs, Bs, Ws, St, piv, blocks, lens, r, F, c):
+def _once(facs, Ws, St, piv, blocks, lens, r, F, c):
     """One elimination solve: (z (n, nrhs), mu (m, nrhs)) of [[Mr, C^T], [C, 0]] [z; mu] =
     [F; c]: per block v = L^-1 F_b, the border's g = F_r - sum W^T v, its LU solve w, and
     z_b = L^-T (v - W w) (= A^-1 (F_b - B w))."""
@@ -294,11 +294,11 @@ def _times_Mr(As, Bs, Mrr, blocks, lens, r, z):
 
 
 def _solve(C, CT, facs, Bs, Ws, St, piv, blocks, lens, r, F, c, refine, As, Mrr):
-    z, mu = _once(facs, Bs, Ws, St, piv, blocks, lens, r, F, c)
+    z, mu = _once(facs, Ws, St, piv, blocks, lens, r, F, c)
     if refine:
         rF = F - _times_Mr(As, Bs, Mrr, blocks, lens, r, z) - np.dot(CT, mu)
         rc = c - np.dot(C, z)
-        dz, dmu = _once(facs, Bs, Ws, St, piv, blocks, lens, r, rF, rc)
+        dz, dmu = _once(facs, Ws, St, piv, blocks, lens, r, rF, rc)
         z = z + dz
         mu = mu + dmu
     return z, mu

@@ -668,11 +668,14 @@ class ElementBatch:
         return self.key == (tuple(id(el.q_xi) for el in elements)
                             + tuple(id(el.q_sub) for el in elements))
 
-    def element_arguments(self) -> tuple:
+    def element_arguments(self, element: int | None = None) -> tuple:
         """The batch kernels' per-plan arguments after the states: (n, the basis tables, the
         reference bases, i_s1, rhoA, Jrot, D per element) -- also the element worker's
-        (:mod:`sim_core.beam.element_worker`)."""
-        return (self.n, *self.tables, self.bases, self.i_s1, self.rhoAs, self.Jrots, self.Ds)
+        (:mod:`sim_core.beam.element_worker`); ``element``: that one element's rows of the
+        per-element tables."""
+        e = slice(None) if element is None else slice(element, element + 1)
+        return (self.n, *self.tables, self.bases[e], self.i_s1, self.rhoAs[e], self.Jrots[e],
+                self.Ds[e])
 
     def __call__(self, QE, QDE, h, g, cstep=_CSTEP):
         """(Me (E, nq, nq), Fe (E, nq)) at the rows of QE, QDE (real, C-contiguous).  No
@@ -688,14 +691,9 @@ class ElementBatch:
         with the steps HQ, HQD (E, nq) at the rows of QE, QDE, QDDE (no finite check here,
         as in __call__); ``element``: the rows are this one element's alone (E = 1)."""
         grav = np.ascontiguousarray(g, dtype=float)
-        args = self.element_arguments()
-        if element is not None:             # its own rows of the per-element tables
-            e = slice(element, element + 1)
-            args = args[:-5] + (self.bases[e], self.i_s1, self.rhoAs[e], self.Jrots[e],
-                                self.Ds[e])
         return _compiled_differences_batch(
-            QE, QDE, QDDE, HQ, HQD, *args, float(h), grav, self.inertia,
-            self.elasticity, bool(np.any(grav != 0.0)), float(cstep), _NO_ACC)
+            QE, QDE, QDDE, HQ, HQD, *self.element_arguments(element), float(h), grav,
+            self.inertia, self.elasticity, bool(np.any(grav != 0.0)), float(cstep), _NO_ACC)
 
 
 def effect_parameters(effects, section):
