@@ -98,7 +98,7 @@ def _no_torsion(offsets, beams) -> LinearConstraint:
     rows = sorted(set(rows))
     z = np.zeros(len(rows))
     return LinearConstraint("no_torsion", [{i: 1.0} for i in rows],
-                            lambda t: z, lambda t: z, lambda t: z)
+                            lambda t: z, lambda t: z, lambda t: z, constant=True)
 
 
 def _axial_flow_velocity(b: Beam, end: str, v: float, d: np.ndarray) -> np.ndarray:

@@ -120,12 +120,31 @@ def constraint_terms(cons: list[NonlinearConstraint], t: float, Q: Vec, Qd: Vec)
 
 
 def targets(cons: list[NonlinearConstraint], t: float):
-    """Stacked (b, b_dot, b_ddot) of the constraints at t."""
-    parts = [c.b(t) for c in cons]
-    return tuple(np.concatenate([p[i] for p in parts]) for i in range(3))
+    """Stacked (b, b_dot, b_ddot) of the constraints at t: the rows of constraints without a
+    target stay zero, only those with one are evaluated (the row layout is kept per list)."""
+    key = tuple(id(c) for c in cons)
+    hit = _TARGET_LAYOUT.get(key)
+    if hit is None:
+        rows, at = 0, []
+        for c in cons:
+            if c.target is not None:
+                at.append((rows, rows + c.m, c))
+            rows += c.m
+        hit = _TARGET_LAYOUT[key] = (rows, at, list(cons))    # the list keeps the ids valid
+        if len(_TARGET_LAYOUT) > 64:
+            _TARGET_LAYOUT.pop(next(iter(_TARGET_LAYOUT)))
+    rows, at, _ = hit
+    out = np.zeros((3, rows))
+    for a, b, c in at:
+        for i, x in enumerate(c.target(t)):
+            out[i, a:b] = x
+    return out[0], out[1], out[2]
 
 
-def kkt_factor(Mr: Vec, C: Vec, blocks=None):
+_TARGET_LAYOUT: dict = {}
+
+
+def kkt_factor(Mr: Vec, C: Vec, blocks=None, refine: bool = True):
     """Factor the saddle-point matrix once; returns solve(Fr, c_rhs) -> (z_ddot, lambda)
     (Fr, c_rhs: vectors or matrices of right-hand sides).
 
@@ -134,10 +153,11 @@ def kkt_factor(Mr: Vec, C: Vec, blocks=None):
     e.g. the beams of ``Model`` (``Model._reduced_mass_force_at``).  Then the system is solved
     by block elimination (:func:`_kkt_factor_blocks`, compiled in
     :mod:`sim_core.saddle_point_compiled` where numba is installed); where a block is not
-    positive definite, by the LU of the whole matrix (the reference)."""
+    positive definite, by the LU of the whole matrix (the reference).  ``refine``: the
+    compiled elimination's step of iterative refinement (the numpy one always refines)."""
     if blocks is not None:
         from . import saddle_point_compiled as compiled
-        solve = (compiled.kkt_factor_blocks(Mr, C, blocks) if compiled.AVAILABLE
+        solve = (compiled.kkt_factor_blocks(Mr, C, blocks, refine) if compiled.AVAILABLE
                  else _kkt_factor_blocks(Mr, C, blocks))
         if solve is not None:
             return solve

@@ -40,6 +40,9 @@ class LinearConstraint:
     value: Callable[[float], np.ndarray]   # b(t)   (m,)
     rate: Callable[[float], np.ndarray]    # b'(t)
     accel: Callable[[float], np.ndarray]   # b''(t)
+    # b does not change in time (b' = b'' = 0): where every constraint is constant, the model
+    # forms A^+ b once (Model._particular) instead of at every state lift
+    constant: bool = False
 
 
 def _const(v):
@@ -81,6 +84,15 @@ class Model:
     # since 2026-11-24 (fourth session): six Cholesky factors of 46 instead of three of 104 and
     # a border of 68 instead of 33, 233 -> 186 us per factorisation at 8 sub-elements
     kkt_blocks: bool = True
+    # one step of iterative refinement after each compiled block-elimination solve
+    # (saddle_point_compiled).  Off since 2026-11-25 (eighth session): with W = L^-1 B and
+    # S = D - W^T W the elimination's rounding grows with cond(L) = cond(A)^(1/2), not cond(A)
+    # (~1e11 with the filter's mass), and its residual is at the whole matrix LU's level
+    # without the step (paper scene at t = 0, 0.5, 5, 15, 16 s: 2e-15 .. 2e-14 of |F_r|, as
+    # the LU's; z_ddot and lambda within 2e-12 of the LU's, refined or not); the step doubled
+    # the solve (0.050 -> 0.120 ms for the friction Newton's five columns).  The numpy
+    # elimination (no numba; A^-1 B by two solves) always refines
+    kkt_refine: bool = False
     # payloads and ropes from one compiled evaluation of their points
     # (point_effects.CompiledPointEffects); False: each effect's local() in Python (the reference)
     point_effects_compiled: bool = True
@@ -142,14 +154,29 @@ class Model:
         """Q, Q_dot from the reduced state."""
         return self._lift(t, z, 0), self._lift(t, zd, 1)
 
+    def _particular(self, t: float, which: int) -> np.ndarray:
+        """A^+ b^(which)(t) (which = 0, 1, 2: position, rate, acceleration level), read-only;
+        formed once where every constraint is constant (b' = b'' = 0)."""
+        cache = self.__dict__.get("_particular_cache")
+        if cache is None:
+            const = bool(self.constraints) and all(c.constant for c in self.constraints)
+            cache = self._particular_cache = [None] * 3 if const else False
+        if cache is False:
+            return self.A_pinv @ self._b(t, which)
+        if cache[which] is None:
+            X = self.A_pinv @ self._b(0.0, which) if which == 0 else np.zeros(self.n_coords)
+            X.flags.writeable = False
+            cache[which] = X
+        return cache[which]
+
     def _lift(self, t: float, x: np.ndarray, which: int) -> np.ndarray:
         """A^+ b^(which)(t) + P x (which = 0, 1, 2: position, rate, acceleration level); P x as
         a signed scatter where P only selects coordinates."""
-        X = self.A_pinv @ self._b(t, which)
+        X = self._particular(t, which)
         if self._sel is None:
             return X + self.P @ x
         rows, sgn, _ = self._sel
-        X = X.astype(np.result_type(X, x), copy=False)
+        X = X.astype(np.result_type(X, x))          # a copy: _particular's may be shared
         X[rows] += sgn * x
         return X
 
@@ -163,8 +190,8 @@ class Model:
 
     def reduced_state(self, t: float, Q: np.ndarray, Qd: np.ndarray):
         """Project a full state onto the constraint manifold's coordinates (z, z_dot)."""
-        z = self.P.T @ (Q - self.A_pinv @ self._b(t, 0))
-        zd = self.P.T @ (Qd - self.A_pinv @ self._b(t, 1))
+        z = self.P.T @ (Q - self._particular(t, 0))
+        zd = self.P.T @ (Qd - self._particular(t, 1))
         return z, zd
 
     # -- assembly --------------------------------------------------------------------------
@@ -493,7 +520,7 @@ class Model:
     def reduced_mass_force(self, t: float, z: np.ndarray, zd: np.ndarray):
         """(M_r, F_r) = (P^T M P, P^T (F - M Qdd_p)): the reduced system M_r z_ddot = F_r."""
         Q, Qd = self.full_state(t, z, zd)
-        return self._reduced_mass_force_at(t, Q, Qd, self.A_pinv @ self._b(t, 2))
+        return self._reduced_mass_force_at(t, Q, Qd, self._particular(t, 2))
 
     def _reduced_mass_force_at(self, t, Q, Qd, Qdd_p, blocks: bool = False, elements=None,
                                pipeline: bool = False):
@@ -569,7 +596,7 @@ class Model:
     def accelerations_and_multipliers(self, t: float, z: np.ndarray, zd: np.ndarray):
         """z_ddot and the multipliers of the nonlinear constraints (empty if there are none)."""
         Q, Qd = self.full_state(t, z, zd)
-        Qdd_p = self.A_pinv @ self._b(t, 2)
+        Qdd_p = self._particular(t, 2)
         if not self.nonlinear:
             Mr, Fr = self._reduced_mass_force_at(t, Q, Qd, Qdd_p)
             return sla.solve(Mr, Fr, assume_a="pos"), np.zeros(0)
@@ -599,7 +626,8 @@ class Model:
         if deferred and deferred[0] is not None:
             solve = self._pipelined_factor(Mr, Fr, self._times_P(J), blocks, deferred[0])
         else:
-            solve = kkt_factor(Mr, self._times_P(J), blocks if self.kkt_blocks else None)
+            solve = kkt_factor(Mr, self._times_P(J), blocks if self.kkt_blocks else None,
+                               refine=self.kkt_refine)
         if newton:
             return self._multiplier_newton(ats, solve, Fr, c_rhs)
         zdd, lam = solve(Fr, c_rhs)
@@ -618,7 +646,8 @@ class Model:
         matrix's LU where a block is not positive definite (as :func:`kkt_factor`)."""
         red = self._red_map                     # blocks is red[2], each element's block red[3]
         solve, out = saddle_point_compiled.kkt_factor_pipelined(
-            Mr, Fr, C, blocks, batch.worker, red[0], red[1], self._element_idx, red[3])
+            Mr, Fr, C, blocks, batch.worker, red[0], red[1], self._element_idx, red[3],
+            refine=self.kkt_refine)
         _checked(out)
         return solve if solve is not None else kkt_factor(Mr, C, None)
 
@@ -677,6 +706,19 @@ class Model:
             g, lam, gv, dg, r = g_new, lam_new, gv_new, dg_new, r_new
         self._g_warm = (idx, g)
         return zdd0 + Z @ g, lam0 + L @ g
+
+    def nonsmooth_rate_columns(self) -> np.ndarray:
+        """Columns of the state Jacobian d(y')/dy, y = (z, z_dot), that carry a non-smooth
+        rate law: the reduced rates the multiplier forces' velocity coordinates depend on
+        (friction: the contact coordinates' s_dot of Eq. 65, whose mu(v) of SCENARIOS A6 is
+        only C0 at |v| = v_eps).  Their velocity coordinates are fixed coordinate indices
+        (``velocity_coords`` does not read Q).  Used by
+        :class:`sim_core.simulate.RefreshedJacobian`; empty without such forces."""
+        full = sorted({int(i) for mf in self.multiplier_forces
+                       if hasattr(mf, "velocity_coords") for i in mf.velocity_coords(None)})
+        if not full:
+            return np.zeros(0, dtype=int)
+        return self.n_dof + np.flatnonzero(np.any(self.P[full] != 0.0, axis=0))
 
     def constraint_violation(self, t: float, z: np.ndarray, zd: np.ndarray) -> np.ndarray:
         """Position-level violation of every nonlinear constraint row (m or rad)."""
@@ -896,6 +938,7 @@ def boundary_condition(model_offsets, beams: list[Beam], ibeam: int, end: str, k
     else:
         s0 = 0.0 if end == "left" else beam.length
         fs, fv, fa = (lambda t: s0), (lambda t: 0.0), (lambda t: 0.0)
+    constant = kind != "sleeve"
     geo = np.asarray(vals, float)
     zero = np.zeros(n_geom)
 
@@ -908,7 +951,8 @@ def boundary_condition(model_offsets, beams: list[Beam], ibeam: int, end: str, k
     def accel(t):
         return np.append(zero, fa(t))
 
-    return LinearConstraint(f"{kind}:{beam.name}:{end}", entries, value, rate, accel)
+    return LinearConstraint(f"{kind}:{beam.name}:{end}", entries, value, rate, accel,
+                            constant=constant)
 
 
 def fix_material_coordinate(model_offsets, beams: list[Beam], ibeam: int, breakpoint: int,
@@ -916,7 +960,8 @@ def fix_material_coordinate(model_offsets, beams: list[Beam], ibeam: int, breakp
     """A breakpoint that is a material point (e.g. the luffing point s_3,1 = L_h, Eq. 50)."""
     idx = int(model_offsets[ibeam]) + beams[ibeam].s_coord(breakpoint)
     v, r, a = _const([value])
-    return LinearConstraint(f"material:{beams[ibeam].name}:{breakpoint}", [{idx: 1.0}], v, r, a)
+    return LinearConstraint(f"material:{beams[ibeam].name}:{breakpoint}", [{idx: 1.0}], v, r, a,
+                            constant=True)
 
 
 def _selection(P: np.ndarray):

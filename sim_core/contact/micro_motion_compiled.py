@@ -52,14 +52,66 @@ def _residual(GT, c5, S, f, R, SR):
 
 
 def _newton_matrix(A, GT, kappa_GA, fp, Jm):
-    """J = G^T diag(f') A + kappa (A^T A + mu Bf^T A), in place (the solver's Newton matrix)."""
+    """J = G^T diag(f') A + kappa (A^T A + mu Bf^T A), in place (the solver's Newton matrix);
+    the springs off their stiff branch (f' = 0: open) add nothing and are skipped."""
     n = A.shape[0]
     for r in range(5):
         for c in range(5):
-            acc = kappa_GA[r, c]
-            for i in range(n):
-                acc += GT[r, i] * fp[i] * A[i, c]
-            Jm[r, c] = acc
+            Jm[r, c] = kappa_GA[r, c]
+    for i in range(n):
+        w = fp[i]
+        if w == 0.0:
+            continue
+        for r in range(5):
+            gw = GT[r, i] * w
+            for c in range(5):
+                Jm[r, c] += gw * A[i, c]
+
+
+def _solve5(Jm, b, transpose):
+    """x = Jm^-1 b (or Jm^-T b) of a 5 x 5 system by Gaussian elimination with partial
+    pivoting on a copy (numpy's LAPACK solve, without its call overhead); NaN where a pivot is
+    zero (the caller treats a non-finite step as a singular Newton matrix)."""
+    M = np.empty((5, 6))
+    for r in range(5):
+        for c in range(5):
+            M[r, c] = Jm[c, r] if transpose else Jm[r, c]
+        M[r, 5] = b[r]
+    for k in range(5):
+        p = k
+        big = abs(M[k, k])
+        for r in range(k + 1, 5):
+            if abs(M[r, k]) > big:
+                big = abs(M[r, k])
+                p = r
+        if big == 0.0:
+            return np.full(5, np.nan)
+        if p != k:
+            for c in range(k, 6):
+                tmp = M[k, c]
+                M[k, c] = M[p, c]
+                M[p, c] = tmp
+        for r in range(k + 1, 5):
+            f = M[r, k] / M[k, k]
+            if f != 0.0:
+                for c in range(k + 1, 6):
+                    M[r, c] -= f * M[k, c]
+    x = np.empty(5)
+    for k in range(4, -1, -1):
+        acc = M[k, 5]
+        for c in range(k + 1, 5):
+            acc -= M[k, c] * x[c]
+        x[k] = acc / M[k, k]
+    return x
+
+
+def _matvec(A, x, out):
+    """out = A x for A (n, 5), in place."""
+    for i in range(A.shape[0]):
+        acc = 0.0
+        for c in range(5):
+            acc += A[i, c] * x[c]
+        out[i] = acc
 
 
 def _sensitivity(A, GT, kappa_GA, fp):
@@ -74,13 +126,14 @@ def _sensitivity(A, GT, kappa_GA, fp):
         return rhs
     Jm = np.empty((5, 5))
     _newton_matrix(A, GT, kappa_GA, fp, Jm)
-    return np.linalg.solve(Jm.T.copy(), rhs)
+    return _solve5(Jm, rhs, True)
 
 
 def _newton(A, GT, kappa_GA, c5, S, x, k0, eps, tol, load_scale, max_iter):
     n = A.shape[0]
     inv_eps = 1.0 / eps
-    delta = A @ x
+    delta = np.empty(n)
+    _matvec(A, x, delta)
     f = np.empty(n)
     fp = np.empty(n)
     R = np.empty(5)
@@ -97,6 +150,8 @@ def _newton(A, GT, kappa_GA, c5, S, x, k0, eps, tol, load_scale, max_iter):
     R_n = np.empty(5)
     SR_n = np.empty(5)
     Jm = np.empty((5, 5))
+    dd = np.empty(n)
+    delta_n = np.empty(n)
     it = 0
     while True:
         if err <= tol:
@@ -107,13 +162,10 @@ def _newton(A, GT, kappa_GA, c5, S, x, k0, eps, tol, load_scale, max_iter):
         if it == max_iter:
             return x, 3, it, err, delta, f, fp, R, np.zeros(5)
         _newton_matrix(A, GT, kappa_GA, fp, Jm)
-        try:
-            d = np.linalg.solve(Jm, -R)
-        except Exception:  # noqa: BLE001 - numba raises a generic LinAlgError here
-            return x, 1, it, err, delta, f, fp, R, np.zeros(5)
+        d = _solve5(Jm, -R, False)
         if not np.isfinite(d @ d):
             return x, 1, it, err, delta, f, fp, R, np.zeros(5)
-        dd = A @ d
+        _matvec(A, d, dd)
         step_max = np.abs(dd).max()
         cap = 4.0 * max(delta.max(), eps)
         s = 1.0 if step_max <= cap else cap / step_max
@@ -121,7 +173,7 @@ def _newton(A, GT, kappa_GA, c5, S, x, k0, eps, tol, load_scale, max_iter):
         for _ in range(60):
             for j in range(5):
                 x_n[j] = x[j] + s * d[j]
-            delta_n = A @ x_n
+            _matvec(A, x_n, delta_n)
             _spring(delta_n, k0, inv_eps, f_n, fp_n)
             phi_n, err_n = _residual(GT, c5, S, f_n, R_n, SR_n)
             if phi_n <= (1.0 - 2.0 * _ARMIJO * s) * phi:
@@ -133,7 +185,7 @@ def _newton(A, GT, kappa_GA, c5, S, x, k0, eps, tol, load_scale, max_iter):
                 return x, 0, it, err, delta, f, fp, R, _sensitivity(A, GT, kappa_GA, fp)
             return x, 2, it, err, delta, f, fp, R, np.zeros(5)
         x = x_n.copy()
-        delta = delta_n
+        delta[:] = delta_n
         f[:] = f_n
         fp[:] = fp_n
         R[:] = R_n
@@ -250,6 +302,8 @@ if AVAILABLE:            # the callees first: numba resolves the globals when ne
     _spring = numba.njit(cache=True, nogil=True)(_spring)
     _residual = numba.njit(cache=True, nogil=True)(_residual)
     _newton_matrix = numba.njit(cache=True, nogil=True)(_newton_matrix)
+    _solve5 = numba.njit(cache=True, nogil=True)(_solve5)
+    _matvec = numba.njit(cache=True, nogil=True)(_matvec)
     _sensitivity = numba.njit(cache=True, nogil=True)(_sensitivity)
     newton = numba.njit(cache=True, nogil=True)(_newton)
     regions_values = numba.njit(cache=True, nogil=True)(_regions_values)
