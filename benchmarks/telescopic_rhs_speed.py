@@ -47,6 +47,12 @@ last evaluation, and a benchmark that repeats one state measures cache hits.  Va
   through a mailbox and an atomic state word instead of the thread pool
   (``Model.element_spin``, ``sim_core.beam.element_worker``: no queue, no thread wake-up, no
   GIL hand-over),
+* ``+ factor pipelined with the worker`` and each element's saddle-point block added and
+  factored as soon as the worker publishes the element (``Model.kkt_pipeline``,
+  ``saddle_point_compiled.kkt_factor_pipelined``; before: after the whole batch),
+* ``+ solves without the refinement step`` and the compiled elimination's solves without
+  their step of iterative refinement (``Model.kkt_refine`` off, the default since
+  2026-11-24: with W = L^-1 B the residual is at the whole LU's level without it),
 
 All variants assemble the reduced system block by block and evaluate each material point once
 for the real and complex-step states (2026-11-24, second session; before, the full N x N mass
@@ -60,7 +66,11 @@ what the fourth changed without a switch: in the element kernel the kinematics o
 complex-step state, J_r in its Kronecker structure (the translational mass without the BLAS
 product, omega and eps_dot as real parts of the convective sums), the saddle-point blocks per
 element instead of per beam, the refinement residual from the blocks (the third session's
-table is ``results/telescopic_rhs_speed_af1e8ab.md``).
+table is ``results/telescopic_rhs_speed_af1e8ab.md``), and what the fifth to eighth changed
+without a switch: among them the constraint program on each point's own columns, the
+saddle-point blocks by W = L^-1 B, the constant boundary conditions' lift formed once, the
+micro-motion Newton's 5 x 5 solves inline (the fourth session's table is
+``results/telescopic_rhs_speed_8dbba34.md``).
 
 then a cProfile of the last variant without the worker thread, grouped by what the time is
 spent on.  Ratios within one
@@ -96,30 +106,20 @@ OUT = os.path.join(os.path.dirname(__file__), "results", "telescopic_rhs_speed.m
 # the element batch on a worker thread, the GIL handed to the worker after submitting,
 # material points in one compiled call, the friction Newton's loop in one compiled call, the
 # constraint rows as one compiled program, the friction Newton warm-started, the payload and
-# ropes from one compiled evaluation of their points)
-_F, _T = False, True
-VARIANTS = (
-    ("fixed point, numpy", _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
-    ("Newton, numpy", _T, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
-    ("+ compiled section", _T, _T, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
-    ("+ compiled micro-motion", _T, _T, _T, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
-    ("+ compiled points", _T, _T, _T, _T, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
-    ("+ compiled elements", _T, _T, _T, _T, _T, _F, _F, _F, _F, _F, _F, _F, _F, _F, _F),
-    ("+ block saddle-point solve", _T, _T, _T, _T, _T, _T, _F, _F, _F, _F, _F, _F, _F, _F, _F),
-    ("+ compiled scatter", _T, _T, _T, _T, _T, _T, _T, _F, _F, _F, _F, _F, _F, _F, _F),
-    ("+ elements on a worker thread", _T, _T, _T, _T, _T, _T, _T, _T, _F, _F, _F, _F, _F, _F, _F),
-    ("+ GIL handed to the worker", _T, _T, _T, _T, _T, _T, _T, _T, _T, _F, _F, _F, _F, _F, _F),
-    ("+ points in one compiled call", _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _F, _F, _F, _F, _F),
-    ("+ friction Newton in one compiled call",
-     _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _F, _F, _F, _F),
-    ("+ constraint rows in one compiled program",
-     _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _F, _F, _F),
-    ("+ friction Newton warm-started", _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _F, _F),
-    ("+ payload and ropes in one compiled call", _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T,
-     _T, _T, _F),
-    ("+ persistent compiled worker", _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T, _T,
-     _T),
+# ropes from one compiled evaluation of their points, the persistent compiled worker, the
+# saddle-point factor pipelined with it, the solves without the refinement step)
+# each variant switches on one more of these, in this order (the first: none)
+_LABELS = (
+    "fixed point, numpy", "Newton, numpy", "+ compiled section", "+ compiled micro-motion",
+    "+ compiled points", "+ compiled elements", "+ block saddle-point solve",
+    "+ compiled scatter", "+ elements on a worker thread", "+ GIL handed to the worker",
+    "+ points in one compiled call", "+ friction Newton in one compiled call",
+    "+ constraint rows in one compiled program", "+ friction Newton warm-started",
+    "+ payload and ropes in one compiled call", "+ persistent compiled worker",
+    "+ factor pipelined with the worker", "+ solves without the refinement step",
 )
+VARIANTS = tuple((label,) + (True,) * k + (False,) * (len(_LABELS) - 1 - k)
+                 for k, label in enumerate(_LABELS))
 
 # cProfile groups: (label, "module file:function" names whose cumulative time is the group's;
 # none of them calls another group's functions)
@@ -140,8 +140,11 @@ GROUPS = (
 def _configure(m, newton: bool, section: bool, micro: bool, points: bool,
                elements: bool, blocks: bool, scatter: bool, thread: bool, handover: bool,
                points_one_call: bool, newton_compiled: bool, rows_compiled: bool,
-               warm_start: bool, point_effects_compiled: bool, spin: bool) -> None:
+               warm_start: bool, point_effects_compiled: bool, spin: bool, pipeline: bool,
+               no_refine: bool) -> None:
     m.multiplier_newton = newton
+    m.kkt_pipeline = pipeline
+    m.kkt_refine = not no_refine
     m.element_spin = spin
     m.point_effects_compiled = point_effects_compiled
     m.multiplier_warm_start = warm_start

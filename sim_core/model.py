@@ -85,9 +85,10 @@ class Model:
     # a border of 68 instead of 33, 233 -> 186 us per factorisation at 8 sub-elements
     kkt_blocks: bool = True
     # one step of iterative refinement after each compiled block-elimination solve
-    # (saddle_point_compiled).  Off since 2026-11-25 (eighth session): with W = L^-1 B and
+    # (saddle_point_compiled).  Off since 2026-11-24 (eighth session): with W = L^-1 B and
     # S = D - W^T W the elimination's rounding grows with cond(L) = cond(A)^(1/2), not cond(A)
-    # (~1e11 with the filter's mass), and its residual is at the whole matrix LU's level
+    # (up to ~1e7 for the paper scene's element blocks with the filter's mass), and its
+    # residual is at the whole matrix LU's level
     # without the step (paper scene at t = 0, 0.5, 5, 15, 16 s: 2e-15 .. 2e-14 of |F_r|, as
     # the LU's; z_ddot and lambda within 2e-12 of the LU's, refined or not); the step doubled
     # the solve (0.050 -> 0.120 ms for the friction Newton's five columns).  The numpy

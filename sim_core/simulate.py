@@ -212,17 +212,22 @@ class RefreshedJacobian:
         return self.J.copy()
 
     def _refresh(self, t, y):
-        J, n = self.J, len(y) // 2
+        n = len(y) // 2
+        failed = self.rhs.n_failed
         f0 = self.rhs(t, y)
         yy = y.copy()
-        for j in self.cols:
+        cols = np.empty((n, len(self.cols)))
+        for k, j in enumerate(self.cols):
             x = y[j]
             e = (x + 1e-7 * max(1.0, abs(x))) - x          # exactly representable step
             yy[j] = x + e
-            J[n:, j] = (self.rhs(t, yy)[n:] - f0[n:]) / e
+            cols[:, k] = (self.rhs(t, yy)[n:] - f0[n:]) / e
             yy[j] = x
+        if self.rhs.n_failed != failed:     # a failed evaluation (its placeholder values):
+            return self.whole(t, y)         # the whole Jacobian, which raises the typed error
+        self.J[n:, self.cols] = cols
         self.rhs.n_refreshes += 1
-        return J.copy()
+        return self.J.copy()
 
 
 class StiffnessDetector:
@@ -292,7 +297,9 @@ class MethodSwitch:
     after its 15 steps) -- unless BDF paid off and its step h is still beyond RK45's
     stability, h rho(J) > ``stay_factor`` x 3.25 with rho(J) the spectral radius
     (:func:`spectral_radius`) of a fresh Jacobian (``fresh_jacobian(solver)``; BDF's own may
-    be stale, it is renewed only when Newton fails): then BDF goes on with that Jacobian for a
+    be stale, it is renewed only when Newton fails; with the structured Jacobian, the last
+    whole one with its friction columns refreshed, :class:`RefreshedJacobian`): then BDF goes
+    on with that Jacobian for a
     stretch twice as long, without the trial, which would cost ~15 stability-limited RK45
     steps (90+ evaluations) to learn what the Jacobian already says.  Each BDF stretch is
     judged against the RK45 stretch before it (cost = model evaluations per simulated second,
@@ -419,7 +426,9 @@ def integrate(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
 
     solver = make(BDF if method == "BDF" else RK45, 0.0, y0)
     # at a BDF stretch's end a fresh Jacobian tells whether RK45 could take BDF's steps; where
-    # it costs less than the RK45 trial it replaces (~100 evaluations): the structured one, or
+    # it costs less than the RK45 trial it replaces (~100 evaluations): the structured one
+    # (through the stretch's RefreshedJacobian: its friction columns refreshed, where the
+    # stiffness of a sticking contact is; the stress filter's eigenvalue pair is constant), or
     # finite differences of a small system
     probe = structured or len(y0) <= 100
     fresh = (lambda s: stretch["jac"](s.t, s.y)) if structured else (lambda s: s.jac(s.t, s.y))

@@ -74,7 +74,8 @@ def test_refreshed_columns_equal_the_structured_jacobian(friction_system):
 def test_refresh_policy():
     """Whole first; refreshed on the next request; after a refreshed step that factored twice
     (Newton failed with the refresh, BDF halved the step) whole again; a refreshed step with
-    one factorisation keeps refreshing."""
+    one factorisation keeps refreshing; a right-hand side that fails within a refresh gives
+    the whole Jacobian (whose own failure is the typed SimulationError)."""
     class Model:
         n_dof = 2
 
@@ -82,6 +83,8 @@ def test_refresh_policy():
             return np.array([3])
 
         def rhs(self, t, y):
+            if t == 0.5:
+                raise FloatingPointError("overflow")
             return np.array([y[2], y[3], -y[0], -np.tanh(y[3] / 0.01)])
 
     rhs = _CountingRHS(Model())
@@ -110,6 +113,8 @@ def test_refresh_policy():
     assert (rhs.n_jacobians, rhs.n_refreshes) == (2, 2)
     jac(0.4, y)                                       # after a whole one: refreshes again
     assert (rhs.n_jacobians, rhs.n_refreshes) == (2, 3)
+    jac(0.5, y)              # a failed evaluation in the refresh: the whole one instead
+    assert (rhs.n_jacobians, rhs.n_refreshes) == (3, 3)
 
 
 def test_bdf_through_breakaway_same_solution_fewer_whole_jacobians(friction_system, monkeypatch):
