@@ -616,14 +616,17 @@ class Model:
                 except Exception:  # noqa: BLE001 - the constraint rows' error is the one raised
                     pass
             raise
-        pipeline = (self.kkt_pipeline and self.kkt_blocks and bool(self.multiplier_forces)
-                    and saddle_point_compiled.PIPELINE)
+        pipeline = self.kkt_pipeline and self.kkt_blocks and saddle_point_compiled.PIPELINE
         Mr, Fr, blocks, *deferred = self._reduced_mass_force_at(
             t, Q, Qd, Qdd_p, blocks=True, elements=elements, pipeline=pipeline)
         xi1, xi2 = self.baumgarte
         c_rhs = c_rhs - J @ Qdd_p - 2.0 * xi1 * dphi - xi2 ** 2 * phi
-        if not self.multiplier_forces:
+        if not (self.multiplier_forces or self.kkt_blocks):
             return kkt_accelerations(Mr, Fr, self._times_P(J), c_rhs)
+        # the saddle-point system by block elimination (pipelined with the worker where it
+        # runs), with friction or without: the frictionless models took the dense LU of the
+        # whole matrix here until 2026-11-24 (eighth session; 2.8 ms per right-hand side at 8
+        # sub-elements of case 9.1, the cost growing as n^1.15 with the sub-elements)
         if deferred and deferred[0] is not None:
             solve = self._pipelined_factor(Mr, Fr, self._times_P(J), blocks, deferred[0])
         else:
@@ -632,6 +635,8 @@ class Model:
         if newton:
             return self._multiplier_newton(ats, solve, Fr, c_rhs)
         zdd, lam = solve(Fr, c_rhs)
+        if not self.multiplier_forces:
+            return zdd, lam
         for _ in range(self.multiplier_max_iter):
             dF = sum(mf.forces(t, Q, Qd, lam) for mf in self.multiplier_forces)
             zdd, lam_new = solve(Fr + self.P.T @ dF, c_rhs)

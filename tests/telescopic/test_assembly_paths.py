@@ -676,3 +676,29 @@ def test_particular_lift_and_targets_equal_their_definitions(state):
             np.testing.assert_array_equal(got[i], np.concatenate([c.b(t)[i] for c in cons]))
     # the sleeve's lift moves with its prescribed flow: a rate that is not zero
     assert np.any(sleeve._particular(1.0, 1) != 0.0)
+
+
+def test_frictionless_model_takes_the_block_elimination(monkeypatch):
+    """Without friction (no multiplier forces: case 9.1 of the cost-growth benchmark) the
+    saddle-point system is solved by the same block elimination, pipelined with the element
+    worker, as with friction -- not by the dense LU of the whole matrix (kkt_accelerations,
+    kept for Model.kkt_blocks False) -- and gives the dense LU's accelerations and multipliers
+    (to 1e-9 of their size; measured 1e-13)."""
+    from sim_core import model as model_module
+    ts = build_telescopic(TelescopicParams(n_nodes=3, friction=False, payload=1000.0, E=2.1e12))
+    m = ts.model
+    assert not m.multiplier_forces
+    z0, zd0 = m.reduced_state(0.0, ts.Q0, np.zeros_like(ts.Q0))
+    rng = np.random.default_rng(11)
+    z = z0 + 1e-4 * rng.standard_normal(m.n_dof)
+    zd = 0.05 * rng.standard_normal(m.n_dof)
+    m.kkt_blocks = False
+    a_ref, lam_ref = m.accelerations_and_multipliers(0.3, z, zd)
+    m.kkt_blocks = True
+
+    def dense(*args):
+        raise AssertionError("the dense LU was used")
+    monkeypatch.setattr(model_module, "kkt_accelerations", dense)
+    a, lam = m.accelerations_and_multipliers(0.3, z, zd)
+    np.testing.assert_allclose(a, a_ref, rtol=0, atol=1e-9 * np.max(np.abs(a_ref)))
+    np.testing.assert_allclose(lam, lam_ref, rtol=0, atol=1e-9 * np.max(np.abs(lam_ref)))
