@@ -625,7 +625,7 @@ class Model:
             return kkt_accelerations(Mr, Fr, self._times_P(J), c_rhs)
         # the saddle-point system by block elimination (pipelined with the worker where it
         # runs), with friction or without: the frictionless models took the dense LU of the
-        # whole matrix here until 2026-11-24 (eighth session; 2.8 ms per right-hand side at 8
+        # whole matrix here until 2026-11-24 (eighth session; ~2.5 ms per right-hand side at 8
         # sub-elements of case 9.1, the cost growing as n^1.15 with the sub-elements)
         if deferred and deferred[0] is not None:
             solve = self._pipelined_factor(Mr, Fr, self._times_P(J), blocks, deferred[0])
