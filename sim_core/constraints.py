@@ -121,27 +121,25 @@ def constraint_terms(cons: list[NonlinearConstraint], t: float, Q: Vec, Qd: Vec)
 
 def targets(cons: list[NonlinearConstraint], t: float):
     """Stacked (b, b_dot, b_ddot) of the constraints at t: the rows of constraints without a
-    target stay zero, only those with one are evaluated (the row layout is kept per list)."""
+    target stay zero, only those with one are evaluated (the row layout is cached on the
+    list's first constraint, as :func:`constraint_compiled.program_for` caches the program)."""
     key = tuple(id(c) for c in cons)
-    hit = _TARGET_LAYOUT.get(key)
-    if hit is None:
+    hit = cons[0].__dict__.get("_target_layout") if cons else None
+    if hit is None or hit[0] != key:
         rows, at = 0, []
         for c in cons:
             if c.target is not None:
                 at.append((rows, rows + c.m, c))
             rows += c.m
-        hit = _TARGET_LAYOUT[key] = (rows, at, list(cons))    # the list keeps the ids valid
-        if len(_TARGET_LAYOUT) > 64:
-            _TARGET_LAYOUT.pop(next(iter(_TARGET_LAYOUT)))
-    rows, at, _ = hit
+        hit = (key, rows, at)
+        if cons:
+            cons[0].__dict__["_target_layout"] = hit
+    _, rows, at = hit
     out = np.zeros((3, rows))
     for a, b, c in at:
         for i, x in enumerate(c.target(t)):
             out[i, a:b] = x
     return out[0], out[1], out[2]
-
-
-_TARGET_LAYOUT: dict = {}
 
 
 def kkt_factor(Mr: Vec, C: Vec, blocks=None, refine: bool = True):

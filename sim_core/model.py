@@ -88,11 +88,11 @@ class Model:
     # (saddle_point_compiled).  Off since 2026-11-24 (eighth session): with W = L^-1 B and
     # S = D - W^T W the elimination's rounding grows with cond(L) = cond(A)^(1/2), not cond(A)
     # (up to ~1e7 for the paper scene's element blocks with the filter's mass), and its
-    # residual is at the whole matrix LU's level
-    # without the step (paper scene at t = 0, 0.5, 5, 15, 16 s: 2e-15 .. 2e-14 of |F_r|, as
-    # the LU's; z_ddot and lambda within 2e-12 of the LU's, refined or not); the step doubled
-    # the solve (0.050 -> 0.120 ms for the friction Newton's five columns).  The numpy
-    # elimination (no numba; A^-1 B by two solves) always refines
+    # residual is at the whole matrix LU's level without the step (paper scene at t = 0, 0.5,
+    # 5, 15, 16 s: 2e-15 .. 2e-14 of |F_r|, as the LU's; z_ddot and lambda within 2e-12 of the
+    # LU's, refined or not); the step doubled the solve (0.050 -> 0.120 ms for the friction
+    # Newton's five columns).  The numpy elimination (no numba; A^-1 B by two solves) always
+    # refines
     kkt_refine: bool = False
     # payloads and ropes from one compiled evaluation of their points
     # (point_effects.CompiledPointEffects); False: each effect's local() in Python (the reference)

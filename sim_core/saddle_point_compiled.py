@@ -4,14 +4,16 @@ The same algorithm as :func:`sim_core.constraints._kkt_factor_blocks` (the refer
 fallback): Cholesky of each block A_i = M_r[b_i, b_i] = L_i L_i^T (``Model``: an element's
 own coordinates), B_i = [M_r[b_i, r], C[:, b_i]^T], W_i = L_i^-1 B_i (one triangular solve;
 A_i^-1 B_i would take two), the Schur complement S = D - sum_i W_i^T W_i of the border
-(coordinates in no block and the multipliers; LU with partial pivoting), and every solve
-followed by one step of iterative refinement on the whole system (its residual from the
-blocks, their border columns and the border rows: the non-zero parts of M_r only; a
-right-hand side that is zero on a block, e.g. a unit load on a border coordinate, skips that
-block's forward solve).  As one compiled factorisation and one compiled solve
+(coordinates in no block and the multipliers; LU with partial pivoting), and with
+``refine`` every solve followed by one step of iterative refinement on the whole system (its
+residual from the blocks, their border columns and the border rows: the non-zero parts of M_r
+only; ``Model.kkt_refine``, off by default: with W = L^-1 B the unrefined residual is at the
+whole matrix LU's level).  A right-hand side that is zero on a block, e.g. a unit load on a
+border coordinate, skips that block's forward solve.  As one compiled factorisation and one
+compiled solve
 the ~30 LAPACK and numpy calls of the Python version (each with its call overhead; 0.4 ms +
-0.25 ms per telescopic right-hand side at 8 sub-elements) become two.  LAPACK (dpotrf, dtrtrs, dgetrf,
-dgetrs of scipy's ``cython_lapack``) is called through external symbols, as
+0.25 ms per telescopic right-hand side at 8 sub-elements) become two.  LAPACK (dpotrf,
+dtrtrs, dgetrf, dgetrs of scipy's ``cython_lapack``) is called through external symbols, as
 :mod:`sim_core.beam.element_compiled` calls dsyrk, so the functions stay cacheable.
 ``tests/telescopic/test_assembly_paths.py`` checks both against the LU of the whole matrix.
 
@@ -45,7 +47,6 @@ if cardan_compiled.AVAILABLE:
             return _types.ExternalFunction(sym, _types.void(*([_types.voidptr] * nargs)))
 
         _dpotrf = _external("dpotrf", 5)     # uplo, n, a, lda, info
-        _dpotrs = _external("dpotrs", 8)     # uplo, n, nrhs, a, lda, b, ldb, info
         _dgetrf = _external("dgetrf", 6)     # m, n, a, lda, ipiv, info
         _dgetrs = _external("dgetrs", 9)     # trans, n, nrhs, a, lda, ipiv, b, ldb, info
         _dtrtrs = _external("dtrtrs", 10)    # uplo, trans, diag, n, nrhs, a, lda, b, ldb, info

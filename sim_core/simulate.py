@@ -183,9 +183,7 @@ class RefreshedJacobian:
         self.J = None                            # the last whole Jacobian (refreshed in place)
         self.pending = None                      # factorisations when the last refresh was made
         self.stale = False                       # Newton failed with a refreshed Jacobian
-        cols_of = getattr(rhs.model, "nonsmooth_rate_columns", None)
-        self.cols = np.asarray(cols_of(), dtype=int) if cols_of is not None else \
-            np.zeros(0, dtype=int)
+        self.cols = np.asarray(rhs.model.nonsmooth_rate_columns(), dtype=int)
 
     def watch(self, solver) -> None:
         """The BDF solver whose factorisations (``nlu``) tell whether a refresh sufficed."""
