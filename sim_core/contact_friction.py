@@ -10,6 +10,25 @@ multiplier eta), so it enters the equations as the generalized force -mu(s_dot) 
 coordinate s_2,k or s_3,k+1.  Because N depends on the multipliers, the model solves for the
 friction values and the multipliers together (Model.multiplier_forces): by Newton in the four
 values -mu N, with the analytic sensitivity of the micro-motion solve (FrictionAtState).
+
+Where the normal load N comes from is the scene's ``contact.friction_load``:
+
+* ``"springs"``: N = sum of the region's slider-spring forces (Eqs. 65-72 literally).  With the
+  rigid moment model a slider of width 2w carries the contact moment M as a force couple of
+  about M / (2w) at its ends, so N grows as 1/w: in the limit w/L -> 0 in which Section 6 derives
+  the rigid orientation constraint, the friction load of this reading diverges.
+* ``"resultant"``: N = |(f_t, f_b)|, the transverse resultant of the contact force, which global
+  equilibrium fixes whatever the slider's width and pressure distribution.  It is the reading of
+  Section 9.2 (4), where the axial component of the constraint force follows its vertical
+  component by "the Coulomb friction ratio", and the one that reproduces the cylinder forces of
+  Figs. 18 and 27 (docs/validation.md).
+
+How much moment a contact region carries is ``contact.moment_model`` (sim_core.telescopic):
+``rigid`` (Section 6: the two bending Cardan angles coincide, multipliers), ``seat`` (they are
+tied by an elastic seat, point_effects.SliderSeat) or ``couple`` (they are free: the overlap
+carries its bending moment as a force couple between its two contact regions).  The twist and
+the two translations are constraints in every model.  :func:`region_multipliers` gives each
+region's three angle multipliers whatever the model, so the section maps below apply to all.
 """
 
 from __future__ import annotations
@@ -63,6 +82,21 @@ def _section_reaction_maps_inv(psi, basis, n_angles: int):
     return -frame[[2, 0, 1]], Lm
 
 
+def region_multipliers(ts, name: str, Q, lam):
+    """(lambda_point (3,), lambda_angles (3,)) of contact region ``name`` (e.g. "II_23"): the
+    point rows' multipliers and the three Cardan-angle multipliers (alpha, beta, gamma) whatever
+    the moment model: the constrained rows from ``lam``, a seat's bending rows as its equivalent
+    multipliers -k g (point_effects.SliderSeat), free rows zero (the couple model)."""
+    lam_angles = np.zeros(3)
+    kept = ts.angle_rows[name]
+    if kept:
+        lam_angles[list(kept)] = lam[ts.rows[name + "_angles"]]
+    seat = ts.seats.get(name)
+    if seat is not None:
+        lam_angles[:2] = seat.multipliers(Q)
+    return lam[ts.rows[name + "_point"]], lam_angles
+
+
 def section_reaction(point, Q, lam_point, lam_angles, basis):
     """Force and moment (section components (s, t, b)) that a coincidence constraint with
     multipliers (lam_point, lam_angles) exerts on its *second* body (see
@@ -75,20 +109,30 @@ def section_reaction(point, Q, lam_point, lam_angles, basis):
 class ContactFriction:
     """Multiplier-dependent friction forces on the contact coordinates of all regions.
 
-    ``distribution=True`` (effects.contact_distribution): the normal load of a region is the sum
-    of its slider-spring forces from the micro-motion solve (Eqs. 59-71).  ``False``: only the
-    constraint resultant is known; the normal load is the magnitude of its transverse force
-    N = |(f_t, f_b)| (a lower bound of the spring sum: the force couples that carry the contact
-    moment are not seen), and no slider geometry is needed, so any number of booms works."""
+    ``distribution=True`` (effects.contact_distribution): each region's slider springs are
+    solved by the micro-motion analysis (Eqs. 59-71) for the outputs.  ``friction_load``:
+    ``"springs"`` (needs the distribution) takes the friction's normal load from their sum,
+    ``"resultant"`` from the transverse contact resultant N = |(f_t, f_b)| (a lower bound of the
+    spring sum: the force couples that carry the contact moment are not in it), which needs no
+    slider geometry, so any number of booms works."""
 
     name = "friction"
 
     def __init__(self, ts, mu_static: float, mu_dynamic: float, v_eps: float,
                  k0: float = 1e9, eps: float = 1e-6, distribution: bool = True,
                  slider_half_width: float = 0.15, springs_per_quarter: int = 20,
-                 radial_gap: float | None = None):
+                 radial_gap: float | None = None, friction_load: str | None = None):
+        if friction_load is None:
+            friction_load = "springs" if distribution else "resultant"
+        if friction_load not in ("springs", "resultant"):
+            raise ValueError(f"friction_load = {friction_load!r} (allowed: 'springs', "
+                             "'resultant')")
+        if friction_load == "springs" and not distribution:
+            raise ValueError("friction_load = 'springs' needs the slider-spring distribution "
+                             "(distribution = True)")
         self.ts = ts
         self.distribution = distribution
+        self.friction_load = friction_load
         self.law = FrictionLaw(mu_static, mu_dynamic, v_eps)
         self.spring = SpringLaw(k0, eps)
         self.basis = ts.model.beams[0].reference_basis
@@ -118,13 +162,20 @@ class ContactFriction:
         """The friction as a function of the multipliers alone, at the state (Q, Qd): the
         section maps and mu(s_dot) are formed once here, not in every multiplier iteration.
         ``only``: indices of the regions to include (default all)."""
-        rows = self.ts.rows
+        ts = self.ts
+        rows = ts.rows
         regions = []
         chosen = self.regions if only is None else [self.regions[k] for k in only]
         for name, point, s_idx, geom in chosen:
-            rp, ra = rows[name + "_point"], rows[name + "_angles"]
-            Lf, Lm = section_reaction_maps(point, Q, self.basis, ra.stop - ra.start)
-            regions.append((name, s_idx, rp, ra, Lf, Lm, self.law.mu(float(Qd[s_idx])), geom))
+            kept = list(ts.angle_rows[name])
+            rp = rows[name + "_point"]
+            ra = rows[name + "_angles"] if kept else slice(0, 0)
+            Lf, Lm3 = section_reaction_maps(point, Q, self.basis, 3)
+            seat = ts.seats.get(name)
+            # the seat's moment does not depend on the multipliers: a constant of the state
+            m0 = None if seat is None else Lm3[:, :2] @ seat.multipliers(Q)
+            regions.append((name, s_idx, rp, ra, Lf, Lm3[:, kept],
+                            self.law.mu(float(Qd[s_idx])), geom, m0))
         return FrictionAtState(self, regions, t, batch=only is None)
 
     def _compiled_regions(self, regions):
@@ -136,8 +187,9 @@ class ContactFriction:
         error)."""
         from .contact import micro_motion_compiled as mmc
         from .contact.sliding_block_contact import _KAPPA, _MAX_ITER, _RTOL
-        if not mmc.AVAILABLE or type(self.spring) is not SpringLaw or not regions:
-            return None
+        if (not mmc.AVAILABLE or type(self.spring) is not SpringLaw or not regions
+                or self.friction_load != "springs" or self.ts.params.moment_model != "rigid"):
+            return None          # the kernels take the rigid model's angle rows
         # what depends on the regions alone (geometry, multiplier rows) is stacked once
         key = tuple(r[0] for r in regions)
         cache = self.__dict__.setdefault("_region_stacks", {})
@@ -251,7 +303,7 @@ class FrictionAtState:
         mu(s_dot) only, so they are formed once per state, not in every friction iteration."""
         if self._mats is None:
             self._mats = [None if geom is None else newton_matrices(geom, self.owner.spring, mu)
-                          for (_, _, _, _, _, _, mu, geom) in self.regions]
+                          for (_, _, _, _, _, _, mu, geom, _) in self.regions]
         return self._mats
 
     def newton(self, lam0, L, tol: float, max_iter: int, g0):
@@ -266,19 +318,31 @@ class FrictionAtState:
         out = []
         x0 = self.owner._x0
         spring = self.owner.spring
-        for name, s_idx, rp, ra, Lf, Lm, mu, geom in self.regions:
+        for name, s_idx, rp, ra, Lf, Lm, mu, geom, m0 in self.regions:
             f_c, m_c = Lf @ lam[rp], Lm @ lam[ra]
+            if m0 is not None:
+                m_c = m_c + m0
+            N_res = float(np.hypot(f_c[1], f_c[2]))
             if geom is None:
-                out.append((name, s_idx, mu, float(np.hypot(f_c[1], f_c[2]))))
+                out.append((name, s_idx, mu, N_res))
                 continue
             sol = solve_micro_motion(geom, spring, f_c, m_c, mu, x0=x0.get(name))
+            if self.owner.friction_load == "resultant" and mu != 0.0:
+                # the friction force mu N_res acts on the springs in proportion to their normal
+                # forces: coefficient mu N_res / sum f_ij in the moment balance (Eqs. 64-71),
+                # a fixed point that settles in a few passes (the sum depends weakly on it)
+                for _ in range(4):
+                    total = sol.total_normal_force
+                    mu_eff = mu * N_res / total if total > 0.0 else 0.0
+                    sol = solve_micro_motion(geom, spring, f_c, m_c, mu_eff, x0=sol.x)
             x0[name] = sol.x
             out.append((name, s_idx, mu, sol))
         return out
 
     def values(self, lam, gradient: bool = False):
         """(g (k,), dg/dlambda (k, m) or None): g_r = -mu_r N_r, N the region's slider-spring
-        sum (micro-motion solve, Eqs. 59-71) or its transverse resultant |(f_t, f_b)|."""
+        sum (micro-motion solve, Eqs. 59-71; friction_load "springs") or its transverse
+        resultant |(f_t, f_b)| ("resultant")."""
         x0 = self.owner._x0
         if self._batch is not None:            # all regions in one compiled call
             out = self._batch(np.ascontiguousarray(lam, dtype=float), x0, gradient)
@@ -287,10 +351,12 @@ class FrictionAtState:
         g = np.empty(len(self.regions))
         dg = np.zeros((len(self.regions), len(lam))) if gradient else None
         spring = self.owner.spring
-        for r, ((name, _, rp, ra, Lf, Lm, mu, geom), mats) in enumerate(
-                zip(self.regions, self._matrices)):
+        resultant = self.owner.friction_load == "resultant"
+        matrices = [None] * len(self.regions) if resultant else self._matrices
+        for r, ((name, _, rp, ra, Lf, Lm, mu, geom, m0), mats) in enumerate(
+                zip(self.regions, matrices)):
             f_c = Lf @ lam[rp]
-            if geom is None:                           # the transverse resultant
+            if resultant:                              # the transverse resultant
                 N = float(np.hypot(f_c[1], f_c[2]))
                 g[r] = -mu * N
                 if gradient and N > 0.0:
@@ -298,7 +364,8 @@ class FrictionAtState:
                 continue
             # Eq. 65's normal load by the micro-motion solve (Eqs. 59-71) and its sensitivity
             # d N / d(f_t, f_b, m_s, m_t, m_b) (ContactSolution.normal_load_gradient)
-            N, dN, x0[name] = normal_load(geom, spring, f_c, Lm @ lam[ra], mu, *mats,
+            m_c = Lm @ lam[ra] if m0 is None else Lm @ lam[ra] + m0
+            N, dN, x0[name] = normal_load(geom, spring, f_c, m_c, mu, *mats,
                                           x0=x0.get(name), t=self.t)
             g[r] = -mu * N
             if gradient and mu != 0.0:

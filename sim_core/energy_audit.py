@@ -33,7 +33,7 @@ from __future__ import annotations
 import numpy as np
 
 from .constraints import constraint_terms
-from .point_effects import RopeDrive
+from .point_effects import RopeDrive, SliderSeat
 
 WORK_NAMES = ("constraint_work", "drive_work", "friction_work", "filter_work")
 
@@ -52,7 +52,7 @@ def rope_energy(rope: RopeDrive, ell: float) -> float:
 
 def mechanical_energy(ts, t: float, z: np.ndarray, zd: np.ndarray) -> float:
     """Material kinetic + strain + gravity energy of the booms, payload point mass (kinetic and
-    gravity) and rope strain energy, J.  The stress filter's mass-like term is not included
+    gravity), rope strain energy and the slider seats' strain energy, J.  The stress filter's mass-like term is not included
     (it is accounted as the filter's work, see the module docstring)."""
     m, p = ts.model, ts.params
     Q, Qd = m.full_state(t, z, zd)
@@ -66,6 +66,8 @@ def mechanical_energy(ts, t: float, z: np.ndarray, zd: np.ndarray) -> float:
     for pe in m.point_effects:
         if isinstance(pe, RopeDrive):
             E += rope_energy(pe, float(np.real(pe.length(Q)[0])))
+        elif isinstance(pe, SliderSeat):
+            E += pe.energy(Q)
     return float(np.real(E))
 
 

@@ -116,6 +116,53 @@ class RopeDrive:
         _add_local(self.local(t, Q, Qd, M is not None), M, F)
 
 
+@dataclass
+class SliderSeat:
+    """Elastic seat of a slider (contact.moment_model = "seat"): the slider may rock relative to
+    the boom section it runs on, resisted by a rotational spring of stiffness ``stiffness``
+    (N m/rad) on the two bending Cardan angles (alpha, beta) of the contact sections.
+
+    Section 6 of Zhao-Qi-Wang 2024 makes the two sections' Cardan angles coincide (Eqs. 47-48);
+    the seat keeps the translations and the twist as constraints and replaces the two bending
+    rows by the potential  V = k/2 |g|^2,  g = Psi_a - Psi_b (bending rows), whose generalized
+    force is F = -k g_Q^T g.  Its virtual power on the contact coordinate s (through g_Q) is the
+    moment term of the contact multiplier eta of Section 7.  With the model's sign convention
+    (M z_ddot = F + C^T lambda) the seat acts as the angle rows' multipliers lambda = -k g, which
+    is what :meth:`multipliers` returns for the contact outputs and the friction normal load."""
+
+    constraint: object                       # the bending rows of an angle_coincidence
+    stiffness: float                         # N m/rad
+    name: str = "seat"
+    time_invariant = True                    # local() does not depend on t
+
+    def coords(self, Q):
+        return self.constraint.coords(Q)
+
+    def velocity_coords(self, Q):
+        """The seat moment does not depend on rates."""
+        return np.zeros(0, dtype=int)
+
+    def multipliers(self, Q) -> np.ndarray:
+        """The equivalent multipliers of the bending rows, -k g (N m)."""
+        g, _ = self.constraint.evaluate(Q)
+        return -self.stiffness * np.real(g)
+
+    def energy(self, Q) -> float:
+        """Strain energy of the seat spring, k/2 |g|^2 (J)."""
+        g, _ = self.constraint.evaluate(Q)
+        g = np.real(g)
+        return 0.5 * self.stiffness * float(g @ g)
+
+    def local(self, t, Q, Qd, mass=True):
+        """(idx, None, -k g_Q^T g) on the coordinates the two sections depend on."""
+        g, J = self.constraint.evaluate(Q)
+        idx = _cols(self.coords(Q), Q)
+        return idx, None, -self.stiffness * (J[:, idx].T @ g)
+
+    def add(self, t, Q, Qd, M, F):
+        _add_local(self.local(t, Q, Qd, M is not None), M, F)
+
+
 def _cols(cols, Q) -> np.ndarray:
     """The coordinates a point effect depends on (all where a point does not say)."""
     return np.arange(len(Q)) if cols is None else np.asarray(cols, dtype=int)
@@ -138,17 +185,34 @@ class CompiledPointEffects:
     ``tests/telescopic/test_assembly_paths.py``); :meth:`build` returns None where an effect
     is of another kind or a point is not a material or fixed point."""
 
-    def __init__(self, effects, rows, program):
+    def __init__(self, effects, rows, program, order=None, uncompiled=()):
         self.effects, self.rows, self.program = effects, rows, program
+        # the model's point effects in order: (True, compiled index) or (False, effect)
+        self.order = order if order is not None else [(True, i) for i in range(len(effects))]
+        self.uncompiled = list(uncompiled)
 
     @staticmethod
     def build(effects) -> "CompiledPointEffects | None":
+        """The compiled program of the payloads and ropes among ``effects``; time-invariant
+        effects of other kinds with a ``local`` form (:class:`SliderSeat`) are evaluated in
+        Python beside it (``uncompiled``).  None where no payload or rope is there, or an
+        effect of another kind is not time-invariant."""
         from .constraint_compiled import DIFF_R, ROPE, program_for
         from .constraints import NonlinearConstraint
-        if not effects or not all(type(pe) in (PointMass, RopeDrive) for pe in effects):
+        compiled = [pe for pe in effects if type(pe) in (PointMass, RopeDrive)]
+        other = [pe for pe in effects if type(pe) not in (PointMass, RopeDrive)]
+        if not compiled or not all(getattr(pe, "time_invariant", False) and hasattr(pe, "local")
+                                   for pe in other):
             return None
-        cons, rows, row = [], [], 0
+        order, k = [], 0
         for pe in effects:
+            if type(pe) in (PointMass, RopeDrive):
+                order.append((True, k))
+                k += 1
+            else:
+                order.append((False, pe))
+        cons, rows, row = [], [], 0
+        for pe in compiled:
             if isinstance(pe, PointMass):
                 spec, m = (DIFF_R, (0, 1, 2), (pe.point,)), 3
             else:
@@ -157,7 +221,8 @@ class CompiledPointEffects:
             rows.append(slice(row, row + m))
             row += m
         program = program_for(cons)
-        return None if program is None else CompiledPointEffects(effects, rows, program)
+        return None if program is None else CompiledPointEffects(compiled, rows, program, order,
+                                                                 other)
 
     def jacobian(self, Q, Qd, Qdd, steps):
         """(d/dQ, d/dQ_dot) (N, N) of the effects' F - M Q_ddot at frozen Q_ddot (their pieces
@@ -196,7 +261,7 @@ class CompiledPointEffects:
         return dQ, dQd
 
     def local(self, Q, Qd, mass=True) -> list:
-        """[(idx, Me or None, Fe)] of every effect, in order (as its ``local``)."""
+        """[(idx, Me or None, Fe)] of every effect, in the model's order (as its ``local``)."""
         g, G, quad, _ = self.program.terms(Q, Qd)
         out = []
         for pe, sl in zip(self.effects, self.rows):
@@ -211,4 +276,7 @@ class CompiledPointEffects:
                 grad = G[sl.start]
                 idx = np.flatnonzero(grad)
                 out.append((idx, None, -pe.tension(float(g[sl.start])) * grad[idx]))
-        return out
+        if not self.uncompiled:
+            return out
+        return [out[k] if compiled else k.local(float("nan"), Q, Qd, mass)
+                for compiled, k in self.order]

@@ -136,7 +136,8 @@ def state_jacobian(model, t: float, y: np.ndarray, rel_step: float = REL_STEP,
         dQ, dQd = pe_batch.jacobian(Q, Qd, Qdd, lambda x: _steps(x, rel_step))
         dR1[:, :N] += dQ
         dR1[:, N:] += dQd
-    for pe in ([] if pe_batch is not None else model.point_effects):   # F_pe - M_pe Q_ddot
+    # F_pe - M_pe Q_ddot of the effects outside the compiled program (slider seats)
+    for pe in (pe_batch.uncompiled if pe_batch is not None else model.point_effects):
         def point_effect(Qx, Qdx, pe=pe):
             F = np.zeros(N)
             if hasattr(pe, "local"):           # a block on a few coordinates

@@ -1,9 +1,11 @@
 """Telescopic boom system of Zhao-Qi-Wang 2024 (Sections 2, 5-7, 9): nested flexible booms with
 moving contact constraints, luffing cylinder, telescopic cylinder, ropes and payload.
 
-Status: contact *resultants* (Constraints I and II with their multipliers, Section 6-7) are in;
-the sliding-block contact distribution and friction of Section 8 are not yet coupled (the
-solver is in sim_core.contact), so the sliding joints are frictionless here.
+Contact regions carry their moment by the scene's ``contact.moment_model``: ``rigid`` (Section 6
+as printed: the sections' Cardan angles coincide), ``seat`` (the bending angles tied by an
+elastic seat, point_effects.SliderSeat) or ``couple`` (the bending angles free, so an overlap
+carries its moment as a force couple between its two regions).  The friction of Section 8.3
+takes its normal load from ``contact.friction_load`` (sim_core.contact_friction).
 
 Booms are numbered from the outermost (1).  Each boom is two moving-node spline elements split
 at its outer contact point (boom 1: at the luffing point s = L_h, a material point, Eq. 50);
@@ -36,7 +38,7 @@ from .constraints import (NonlinearConstraint, angle_coincidence, distance_drive
 from .drive_profiles import CubicSmoothstepSchedule
 from .effects import Effect, Elasticity, Gravity, Inertia, StressFilter
 from .model import Model, boundary_condition, fix_material_coordinate
-from .point_effects import PointMass, RopeDrive
+from .point_effects import PointMass, RopeDrive, SliderSeat
 from .validation.closed_form import luffing_geometry, static_luffing_forces
 
 # SCENARIOS A1 Table 2 (EI_t = EI_b, GJ, m'), EA = E m'/rho (proposed default)
@@ -76,6 +78,9 @@ class TelescopicParams:
     mu_static: float = 0.15
     mu_dynamic: float = 0.1
     v_eps: float = 0.01                     # m/s, switching speed
+    moment_model: str = "rigid"             # slider moment: "rigid" (Sec. 6), "seat", "couple"
+    seat_stiffness: float = 1e8             # N m/rad, rocking stiffness of a slider seat
+    friction_load: str = "resultant"        # friction normal load: "resultant" or "springs"
     spring_k0: float = 1e9                  # N/m per radial spring (SCENARIOS A6)
     spring_eps: float = 1e-6                # m, smoothing interval
     slider_width: float = 0.3               # m, 2w: slider length along the boom (SCENARIOS A1)
@@ -105,6 +110,10 @@ class TelescopicSystem:
     tip: callable                           # point function of the tip (boom N, s = L)
     params: TelescopicParams
     contact: object = None                  # contact_friction.ContactFriction, if built
+    # per contact region ("I_12", "II_12", ...): the Cardan-angle rows kept as constraints
+    # (0, 1 bending, 2 twist) and, for the seat model, its point_effects.SliderSeat
+    angle_rows: dict = field(default_factory=dict)
+    seats: dict = field(default_factory=dict)
 
 
 def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
@@ -173,16 +182,27 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
     D3 = mp(0, s_fixed=p.L_h, offset=(0.0, 0.0, -0.556))
     Lc = float(geo.cylinder_length)
     add(distance_driver("luffing_cylinder", D3, fixed_point(geo.d2), lambda t: (Lc, 0.0, 0.0)))
-    # contact constraints I and II between adjacent booms (Section 6)
+    # contact constraints I and II between adjacent booms (Section 6).  The moment model decides
+    # which Cardan-angle rows stay constraints: all three (rigid, Eqs. 47-48), or the twist only
+    # (seat: the bending rows become an elastic seat; couple: they are free)
+    if p.moment_model not in ("rigid", "seat", "couple"):
+        raise ValueError(f"moment_model = {p.moment_model!r} (allowed: 'rigid', 'seat', "
+                         "'couple')")
+    kept = tuple(bend) if p.moment_model == "rigid" else tuple(i for i in bend if i == 2)
+    angle_rows, seats = {}, {}
+
+    def contact_region(name, fa, fb):
+        add(point_coincidence(name + "_point", fa, fb))
+        angle_rows[name] = kept
+        if kept:
+            add(angles(name + "_angles", fa, fb, keep=kept))
+        if p.moment_model == "seat":
+            seats[name] = SliderSeat(_rows(angle_coincidence(name + "_seat", fa, fb), [0, 1]),
+                                     p.seat_stiffness, name=name + "_seat")
+
     for k in range(N - 1):
-        inner = mp(k, s_index=s2_index[k])
-        left_next = mp(k + 1, s_fixed=0.0)
-        add(point_coincidence(f"I_{k + 1}{k + 2}_point", left_next, inner))
-        add(angles(f"I_{k + 1}{k + 2}_angles", left_next, inner))
-        right = mp(k, s_fixed=L)
-        outer_next = mp(k + 1, s_index=s3_index[k + 1])
-        add(point_coincidence(f"II_{k + 1}{k + 2}_point", right, outer_next))
-        add(angles(f"II_{k + 1}{k + 2}_angles", right, outer_next))
+        contact_region(f"I_{k + 1}{k + 2}", mp(k + 1, s_fixed=0.0), mp(k, s_index=s2_index[k]))
+        contact_region(f"II_{k + 1}{k + 2}", mp(k, s_fixed=L), mp(k + 1, s_index=s3_index[k + 1]))
     # telescopic cylinder between the left sections of booms 1 and 2 (A3, A4)
     sched = CubicSmoothstepSchedule(v_max=p.v_max, t_ramp=p.t_ramp, t_hold_end=p.t_hold_end,
                                     sign=p.direction, s0=Ls)
@@ -225,8 +245,9 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
             cons.append(c)
             rows["rope"] = slice(i, i + 1)
             model.nonlinear = cons
-    model.point_effects = pe
-    ts = TelescopicSystem(model, Q0, sched, s2_index, s3_index, rows, tip, p)
+    model.point_effects = pe + list(seats.values())
+    ts = TelescopicSystem(model, Q0, sched, s2_index, s3_index, rows, tip, p,
+                          angle_rows=angle_rows, seats=seats)
     # Section 8 contact analysis: the slider-spring distribution needs the paper's three-boom
     # slider geometry; with friction off it is only evaluated for the outputs (it does not act
     # on the motion), with contact_distribution off it is not built at all
@@ -235,13 +256,16 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
     if p.contact_distribution and N != 3:
         raise ValueError(f"contact_distribution with n_booms = {N}: the slider geometry is the "
                          "paper's three-boom section (allowed: 3)")
+    if p.friction and p.friction_load == "springs" and not p.contact_distribution:
+        raise ValueError("friction_load = 'springs' needs contact_distribution (the slider "
+                         "springs); allowed: friction_load = 'resultant'")
     if p.friction or p.contact_distribution:
         from .contact_friction import ContactFriction
         ts.contact = ContactFriction(ts, p.mu_static, p.mu_dynamic, p.v_eps, p.spring_k0,
                                      p.spring_eps, distribution=p.contact_distribution,
                                      slider_half_width=0.5 * p.slider_width,
                                      springs_per_quarter=p.springs_per_quarter,
-                                     radial_gap=p.radial_gap)
+                                     radial_gap=p.radial_gap, friction_load=p.friction_load)
     if p.friction:
         model.multiplier_forces = [ts.contact]
     return ts
@@ -383,7 +407,7 @@ def _telescopic_result(ts: TelescopicSystem, t, ys, stats, error):
                            "luffing_cylinder_force", "telescopic_cylinder_force",
                            "contact_point_forces", "inner_contact_s", "outer_contact_s",
                            "constraint_violation")}
-    from .contact_friction import section_reaction
+    from .contact_friction import region_multipliers, section_reaction
     basis = m.beams[0].reference_basis
     left1 = material_point(m, 0, s_fixed=0.0)
     left2 = material_point(m, 1, s_fixed=0.0)
@@ -406,8 +430,8 @@ def _telescopic_result(ts: TelescopicSystem, t, ys, stats, error):
             outer = material_point(m, k + 1, s_index=ts.s3_index[k + 1])
             pair = []
             for name, point in ((f"I_{k + 1}{k + 2}", inner), (f"II_{k + 1}{k + 2}", outer)):
-                f_sec, m_sec = section_reaction(point, Q, lam[ts.rows[name + "_point"]],
-                                                lam[ts.rows[name + "_angles"]], basis)
+                f_sec, m_sec = section_reaction(point, Q, *region_multipliers(ts, name, Q, lam),
+                                                basis)
                 pair.append(np.concatenate([f_sec, m_sec]))
             cpf.append(pair)
         out["contact_point_forces"].append(cpf)

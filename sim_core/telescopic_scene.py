@@ -19,9 +19,8 @@
                the angle constraints dropped), gravity (bool), filtering (bool: stress
                averaging with [filtering] h), friction (bool, default false: Coulomb friction
                on the contact coordinates, Section 8.3), contact_distribution (bool, default
-               true for 3 booms: slider-spring analysis of Section 8, outputs
-               slider_contact_forces, and the friction normal load = spring sum; false = only
-               the constraint resultants, friction normal load = transverse resultant),
+               true for 3 booms: slider-spring analysis of Section 8, output
+               slider_contact_forces; false = only the constraint resultants),
                rope_elasticity (bool, default true: elastic tension-only ropes with [ropes] EA;
                false = one inextensible rope constraint, output rope_tension),
                mass_centre_offset (bool, default false: mass on the reference line; true =
@@ -32,7 +31,15 @@
                slider_width m (2w, > 0 and shorter than the smallest overlap L - max L_s),
                springs_per_quarter (1..200 springs per quarter arc and slider end),
                radial_gap m ((0, 0.05]: sliding-block thickness between the walls; sets the
-               contact-circle radius, default 5 mm of Table 1)
+               contact-circle radius, default 5 mm of Table 1),
+               moment_model ("rigid" default: Section 6, the contact sections' Cardan angles
+               coincide; "seat": the two bending angles tied by an elastic seat of
+               seat_stiffness N m/rad (> 0, default 1e8: a 20 mm polyamide pad, E = 3 GPa, on a
+               0.3 m x 0.3 m footprint); "couple": the bending angles free, the overlap carries
+               its moment as a force couple between its two regions),
+               friction_load ("resultant" default: the friction's normal load is the transverse
+               contact resultant |(f_t, f_b)|; "springs": the sum of the slider springs, Eq. 72
+               literally, needs contact_distribution) -- docs/validation.md says why
   [filtering]  h s (> 0)
   [gravity]    g m/s^2 (> 0, along -Z)
   [model]      reduction ("none" = full model, "modal" = stroke-parametric modal ROM of
@@ -118,7 +125,8 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
                              "reactions are statically indeterminate (allowed: friction = false)")
     c = raw.get("contact", {})
     check_keys(c, {"mu_static", "mu_dynamic", "v_eps", "k0", "eps", "slider_width",
-                   "springs_per_quarter", "radial_gap"}, "contact")
+                   "springs_per_quarter", "radial_gap", "moment_model", "seat_stiffness",
+                   "friction_load"}, "contact")
     sc["contact"] = {"mu_static": number(c, "mu_static", "contact", 0.15, lo=0.0),
                      "mu_dynamic": number(c, "mu_dynamic", "contact", 0.1, lo=0.0),
                      "v_eps": number(c, "v_eps", "contact", 0.01, lo=0.0, lo_open=True),
@@ -131,7 +139,23 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
                      # a gap wider than 50 mm would put the contact circle of the 75 mm top arcs
                      # near their centre (Table 1 radii)
                      "radial_gap": number(c, "radial_gap", "contact", 0.005, lo=0.0, hi=0.05,
-                                          lo_open=True)}
+                                          lo_open=True),
+                     "moment_model": choice(c, "moment_model", "contact",
+                                            ("rigid", "seat", "couple"), "rigid"),
+                     # a polyamide pad (E = 3 GPa) 20 mm thick on a 0.3 m x 0.3 m footprint
+                     # rocking about its centre: E/t * b (2w)^3 / 12 = 1.0e8 N m/rad
+                     "seat_stiffness": number(c, "seat_stiffness", "contact", 1e8, lo=0.0,
+                                              lo_open=True),
+                     "friction_load": choice(c, "friction_load", "contact",
+                                             ("resultant", "springs"), "resultant")}
+    cc = sc["contact"]
+    if cc["friction_load"] == "springs" and not eff["contact_distribution"]:
+        raise SceneError("contact.friction_load = 'springs' with effects.contact_distribution = "
+                         "false: the spring sum needs the slider springs (allowed: "
+                         "friction_load = 'resultant', or contact_distribution = true)")
+    if cc["moment_model"] != "rigid" and not eff["flexible"]:
+        raise SceneError(f"contact.moment_model = {cc['moment_model']!r} with effects.flexible = "
+                         "false: the rigid limit has no contact sections (allowed: 'rigid')")
     # the two sliders of a pair (boom k+1's left-end slider inside boom k, boom k's right-end
     # slider on boom k+1) must fit in the overlap L - L_s(t) at its shortest
     ls_max = max(sc["booms"]["stroke0"], end)
@@ -150,6 +174,10 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
     check_keys(mo, {"reduction", "n_modes"}, "model")
     sc["model"] = {"reduction": choice(mo, "reduction", "model", ("none", "modal"), "none"),
                    "n_modes": number(mo, "n_modes", "model", 3, lo=1, hi=4, integer=True)}
+    if sc["model"]["reduction"] == "modal" and sc["contact"]["moment_model"] != "rigid":
+        raise SceneError(f"model.reduction = 'modal' with contact.moment_model = "
+                         f"{sc['contact']['moment_model']!r}: the modal tables are built with the "
+                         "rigid contact sections (allowed: 'rigid')")
     if sc["model"]["reduction"] == "modal" and sc["effects"]["friction"]:
         raise SceneError("model.reduction = 'modal' with effects.friction = true: the modal tables "
                          "are frictionless; set effects.friction = false")
@@ -174,6 +202,9 @@ def params_from_scene(sc: dict):
         slider_width=sc["contact"]["slider_width"],
         springs_per_quarter=sc["contact"]["springs_per_quarter"],
         radial_gap=sc["contact"]["radial_gap"],
+        moment_model=sc["contact"]["moment_model"],
+        seat_stiffness=sc["contact"]["seat_stiffness"],
+        friction_load=sc["contact"]["friction_load"],
         torsion=sc["effects"]["torsion"], rope_elasticity=sc["effects"]["rope_elasticity"],
         flexible=sc["effects"]["flexible"],
         mass_centre_offset=sc["effects"]["mass_centre_offset"])

@@ -92,6 +92,25 @@ def test_telescopic_jacobian_matches_whole_rhs_differences(telescopic, v_contact
     assert err < max(20.0 * spread, 1e-7), (err, spread)
 
 
+@pytest.mark.parametrize("moment_model", ["seat", "couple"])
+def test_telescopic_jacobian_of_the_other_moment_models(moment_model):
+    """The seat's elastic moments (point_effects.SliderSeat, evaluated beside the compiled
+    payload and ropes) and the couple model's twist-only angle rows, sliding, with friction
+    from the contact resultant."""
+    p = TelescopicParams(n_nodes=3, E=2.1e12, payload=1000.0, friction=True,
+                         moment_model=moment_model)
+    ts = build_telescopic(p)
+    z, _ = initial_equilibrium(ts)
+    for pe in ts.model.point_effects:
+        if pe.name == "retraction_rope":
+            pe.L0 += 1e-3
+    if moment_model == "seat":
+        assert ts.model._compiled_point_effects().uncompiled == list(ts.seats.values())
+    y = _state(ts, z, 0.05)
+    err, spread = _check(ts.model, 3.0, y, _columns(ts.model, ts))
+    assert err < max(20.0 * spread, 1e-7), (err, spread)
+
+
 def test_beam_jacobian_matches_whole_rhs_differences():
     """No nonlinear constraints: sleeve (time-dependent linear constraint), point load,
     gravity, stress filter - every column."""

@@ -104,6 +104,39 @@ def test_rigid_limit_rejects_friction():
     assert "effects.friction = true with effects.flexible = false" in msg
 
 
+def test_contact_models_are_choices_with_their_allowed_values():
+    msg = _err({"contact.moment_model": "hinge"})
+    assert "contact.moment_model" in msg and "rigid" in msg and "couple" in msg
+    msg = _err({"contact.friction_load": "sum"})
+    assert "contact.friction_load" in msg and "resultant" in msg and "springs" in msg
+    msg = _err({"contact.seat_stiffness": 0.0})
+    assert "contact.seat_stiffness" in msg
+
+
+def test_spring_friction_load_needs_the_slider_springs():
+    msg = _err({"contact.friction_load": "springs", "effects.contact_distribution": False})
+    assert "contact.friction_load = 'springs' with effects.contact_distribution = false" in msg
+
+
+def test_modal_rom_and_rigid_limit_have_only_the_rigid_moment_model():
+    msg = _err({"contact.moment_model": "couple"}, scene="telescopic_extraction_rl")
+    assert "model.reduction = 'modal' with contact.moment_model = 'couple'" in msg
+    msg = _err({"contact.moment_model": "seat", "effects.flexible": False,
+                "effects.friction": False})
+    assert "contact.moment_model = 'seat' with effects.flexible = false" in msg
+
+
+def test_contact_models_reach_the_model_parameters():
+    sc = load_scene(SCENE)
+    p = params_from_scene(sc)
+    assert (p.moment_model, p.friction_load) == ("rigid", "resultant")      # the defaults
+    sc = load_scene(SCENE, overrides={"contact.moment_model": "seat",
+                                      "contact.seat_stiffness": 3e7,
+                                      "contact.friction_load": "springs"})
+    p = params_from_scene(sc)
+    assert (p.moment_model, p.seat_stiffness, p.friction_load) == ("seat", 3e7, "springs")
+
+
 def test_effect_switches_reach_the_model_parameters():
     sc = load_scene(SCENE, overrides={"effects.friction": False, "effects.torsion": False,
                                       "effects.rope_elasticity": False,

@@ -9,7 +9,11 @@ to the solver tolerance.  The works are integrated as extra states of the same R
 Setup: the paper's scene 9.2 (E = 2.1e11 Pa, 25 t, 60 deg, friction 0.1/0.15, v_eps 0.01 m/s,
 filter h = 0.01) at 2 sub-elements per spline element, from its static equilibrium, with the
 cubic ramp shortened to 0.5 s so that the 0.15 s window goes from stick (s_dot = 0) into
-sliding (s_dot ~ 0.1 m/s > 2 v_eps).  ~1 min on the 2-core machine.
+sliding (s_dot ~ 0.1 m/s > 2 v_eps).  ~1 min on the 2-core machine per combination.
+
+Every combination of the slider-moment model (contact.moment_model: rigid, seat, couple) and
+the friction's normal load (contact.friction_load: resultant, springs) closes the same balance;
+the defaults (rigid, resultant) run in the default suite, the other five in the slow one.
 """
 
 import numpy as np
@@ -21,10 +25,18 @@ from sim_core.telescopic import TelescopicParams, build_telescopic, initial_equi
 RTOL = 1e-6
 
 
-@pytest.fixture(scope="module")
-def audit():
+COMBINATIONS = [pytest.param(("rigid", "resultant"), id="rigid-resultant")] + [
+    pytest.param((mm, fl), id=f"{mm}-{fl}", marks=pytest.mark.slow)
+    for mm in ("rigid", "seat", "couple") for fl in ("resultant", "springs")
+    if (mm, fl) != ("rigid", "resultant")]
+
+
+@pytest.fixture(scope="module", params=COMBINATIONS)
+def audit(request):
+    moment_model, friction_load = request.param
     p = TelescopicParams(n_nodes=3, E=2.1e11, payload=25000.0, luffing_angle_deg=60.0,
-                         stroke0=2.0, t_ramp=0.5, t_hold_end=0.6, friction=True)
+                         stroke0=2.0, t_ramp=0.5, t_hold_end=0.6, friction=True,
+                         moment_model=moment_model, friction_load=friction_load)
     ts = build_telescopic(p)
     z, _ = initial_equilibrium(ts)
     return run_energy_audit(ts, np.concatenate([z, 0 * z]), 0.15, rtol=RTOL, atol=RTOL / 10,
@@ -47,11 +59,12 @@ def test_energy_balance_to_solver_tolerance(audit):
 
 def test_every_term_matters(audit):
     """The check can fail: leaving out the friction or the filter work, or taking the drive
-    work with the wrong sign, breaks the balance by far more than the tolerance."""
+    work with the wrong sign, breaks the balance by far more than the tolerance (the filter's
+    work is the smallest term: with friction from the contact resultant ~100 x the tolerance)."""
     tol = RTOL * _scale(audit)
     r = audit["residual"]
     assert np.max(np.abs(r + audit["friction_work"])) > 100 * tol
-    assert np.max(np.abs(r + audit["filter_work"])) > 100 * tol
+    assert np.max(np.abs(r + audit["filter_work"])) > 20 * tol
     assert np.max(np.abs(r + 2 * audit["constraint_work"])) > 100 * tol
 
 

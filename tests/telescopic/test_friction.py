@@ -8,8 +8,10 @@ from sim_core.telescopic import TelescopicParams, build_telescopic, initial_equi
 
 @pytest.fixture(scope="module")
 def systems():
+    """The friction with its normal load from the slider springs (contact.friction_load =
+    "springs": the micro-motion machinery these tests check) and the frictionless system."""
     base = dict(n_nodes=3, E=2.1e12, payload=1000.0)
-    ts_f = build_telescopic(TelescopicParams(friction=True, **base))
+    ts_f = build_telescopic(TelescopicParams(friction=True, friction_load="springs", **base))
     ts_0 = build_telescopic(TelescopicParams(friction=False, **base))
     z, _ = initial_equilibrium(ts_0)
     # the same rope lengths in both systems (set at the frictionless equilibrium)
@@ -63,6 +65,27 @@ def test_friction_dissipates_and_balances_the_axial_reaction(systems):
             assert abs(f_sec[0]) == pytest.approx(abs(mu) * sol.total_normal_force, rel=1e-2)
 
 
+def test_resultant_friction_load_balances_the_axial_reaction(systems):
+    """contact.friction_load = "resultant": while sliding, the axial reaction of region I (the
+    auxiliary equation Eq. 72) is mu times the transverse contact resultant |(f_t, f_b)| - the
+    Coulomb ratio between the constraint force's axial and normal components that Section 9.2
+    (4) describes - up to the curvature coupling term (booms nearly straight: < 1 %)."""
+    from sim_core.contact_friction import region_multipliers, section_reaction
+    _, _, z = systems
+    ts = build_telescopic(TelescopicParams(n_nodes=3, E=2.1e12, payload=1000.0, friction=True,
+                                           friction_load="resultant"))
+    m = ts.model
+    Q, Qd = _sliding_state(ts, z)
+    zd = m.reduced_state(0.0, Q, Qd)[1]
+    _, lam = m.accelerations_and_multipliers(0.0, z, zd)
+    fr = m.multiplier_forces[0]
+    assert fr.forces(0.0, Q, Qd, lam) @ Qd < 0.0
+    for name, point, _, _ in fr.regions:
+        if name.startswith("I_"):
+            f, _ = section_reaction(point, Q, *region_multipliers(ts, name, Q, lam), fr.basis)
+            assert abs(f[0]) == pytest.approx(0.1 * np.hypot(f[1], f[2]), rel=1e-2)
+
+
 def test_friction_raises_the_telescopic_cylinder_force(systems):
     """Extracting against friction needs more cylinder force than without it (same state)."""
     ts_f, ts_0, z = systems
@@ -112,6 +135,7 @@ def test_multiplier_newton_matches_the_converged_fixed_point(systems, distributi
     saved = (fr.distribution, fr.regions, m.multiplier_tol, m.multiplier_max_iter)
     if not distribution:
         fr.regions = [(n, p, s, None) for n, p, s, _ in fr.regions]
+        fr.friction_load = "resultant"
     Q, Qd = _sliding_state(ts_f, z, 0.3)
     zd = m.reduced_state(0.0, Q, Qd)[1]
     calls = []
@@ -139,17 +163,23 @@ def test_multiplier_newton_matches_the_converged_fixed_point(systems, distributi
         m.multiplier_newton = True
         m.multiplier_newton_compiled = True
         fr.distribution, fr.regions, m.multiplier_tol, m.multiplier_max_iter = saved
+        fr.friction_load = "springs"
     # the friction changes the multipliers by O(10 %): a 1e-9 agreement needs both solves
     assert np.max(np.abs(lam - lam_ref)) < 1e-9 * np.max(np.abs(lam_ref))
     assert np.max(np.abs(a - a_ref)) < 1e-9 * np.max(np.abs(a_ref))
     assert n_newton < n_fixed
 
 
-def test_friction_multiplier_gradient_matches_finite_differences(systems):
-    """dg/dlambda of FrictionAtState (section maps and micro-motion sensitivity) vs central
-    differences in every multiplier; step 1e-6 of max |lambda|, tolerance 1e-5 of the largest
-    entry (truncation of the C1 spring law and the 1e-11 solver tolerance are far below)."""
+@pytest.mark.parametrize("friction_load", ["springs", "resultant"])
+def test_friction_multiplier_gradient_matches_finite_differences(systems, friction_load):
+    """dg/dlambda of FrictionAtState (section maps and micro-motion sensitivity, or the
+    resultant's direction) vs central differences in every multiplier; step 1e-6 of
+    max |lambda|, tolerance 1e-5 of the largest entry (truncation of the C1 spring law and the
+    1e-11 solver tolerance are far below)."""
     ts_f, _, z = systems
+    if friction_load == "resultant":
+        ts_f = build_telescopic(TelescopicParams(n_nodes=3, E=2.1e12, payload=1000.0,
+                                                 friction=True, friction_load="resultant"))
     m = ts_f.model
     Q, Qd = _sliding_state(ts_f, z, 0.3)
     zd = m.reduced_state(0.0, Q, Qd)[1]
