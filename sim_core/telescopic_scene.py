@@ -4,7 +4,7 @@
   [solver]     t_end s (> 0), rtol (0, 1), atol (> 0), n_output (>= 2), method ("RK45", "BDF",
                "auto"), max_step s and max_wall_s s (> 0, optional; max_wall_s: wall-clock budget,
                stops with a partial result)
-  [booms]      count (2..5; ropes only for 3), length m (> 0), luffing_angle_deg (0..85),
+  [booms]      count (2..3; ropes only for 3), length m (> 0), luffing_angle_deg (0..85),
                stroke0 m (piston-rod length L_s at t = 0, > 0), L_h m (luffing point on boom 1,
                within (0, length)), E Pa (> 0), rho kg/m^3 (> 0), n_nodes (3..33 per spline
                element; paper 9), n_gauss (1..10)
@@ -69,7 +69,15 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
     check_keys(b, {"count", "length", "luffing_angle_deg", "stroke0", "L_h", "E", "rho",
                    "n_nodes", "n_gauss"}, "booms")
     L = number(b, "length", "booms", 10.0, lo=0.0, lo_open=True)
-    sc["booms"] = {"count": number(b, "count", "booms", 3, lo=2, hi=5, integer=True),
+    count = b.get("count", 3)
+    if isinstance(count, int) and not isinstance(count, bool) and count > 3:
+        # the paper's drive (one telescopic cylinder between booms 1 and 2, the rope pair that
+        # moves boom 3 with it, Section 2 and 9) moves three booms; four or more sections need
+        # a drive mechanism of their own (synchronized or sequential), not modelled
+        raise SceneError(f"booms.count = {count}: the paper's single-cylinder-and-rope drive "
+                         "moves at most 3 booms; sections 4 and beyond have no drive in this "
+                         "model and the statics fail (allowed: 2 or 3)")
+    sc["booms"] = {"count": number(b, "count", "booms", 3, lo=2, hi=3, integer=True),
                    "length": L,
                    "luffing_angle_deg": number(b, "luffing_angle_deg", "booms", 60.0, lo=0.0, hi=85.0),
                    "stroke0": number(b, "stroke0", "booms", 2.0, lo=0.0, hi=L, lo_open=True, hi_open=True),
