@@ -10,7 +10,7 @@ and the friction load N (sum of the slider spring forces, N).  When 40 consecuti
 steps are below 0.3 ms after t = 1 s it stops and analyses the state: the right-hand side
 evaluated repeatedly (inner-iteration noise), the friction state of every region, the rope
 stretches, and the eigenvalues of a central-difference Jacobian of the right-hand side with the
-coordinates their eigenvectors load most (README *Status* has the findings).  ~10 min at
+coordinates their eigenvectors load most (findings: CHANGELOG.md, docs/model.md).  ~10 min at
 n_nodes = 3 on the 2-core machine.
 """
 

@@ -10,8 +10,8 @@ discrete switch in the residual along combined moves.  At n_nodes = 3 Newton con
 iterations, and there the same check gives |cen - K d| = 0.2 % of |K d|.  At n_nodes = 9 the central
 difference along d (e = 1e-5) differs from K d by 200 % while forward and backward differences
 agree to 1 %: the mismatch sits in the moves of booms 2 and 3 (whose junction s_3 is a
-coordinate), not boom 1 (junction fixed at L_h).  Kept to reproduce the problem; see README
-"Status".
+coordinate), not boom 1 (junction fixed at L_h).  Kept to reproduce the problem; the statics
+use central differences because of it (sim_core.statics._force_tangent, CHANGELOG.md).
 """
 import numpy as np, sys
 from sim_core.telescopic import TelescopicParams, build_telescopic

@@ -11,7 +11,7 @@ overrides, exactly as a user would: ``--set effects.friction=false`` ...), and t
 (``effects.flexible=false``, which needs friction off).  For each row: wall time of the static
 equilibrium and of the dynamics, RK45 steps and RHS evaluations, wall seconds per simulated
 second, and the speed-up against the full scene.  The window is short because the full scene is
-slow (see benchmarks/WORK_PRECISION.md for the cost per simulated second in general); all rows
+slow (see docs/performance.md for the cost per simulated second in general); all rows
 use the same window, so the ratios are what the table is for.
 
 Writes benchmarks/results/effects_speed.csv and .md (atomically).  ``--quick``: 2 sub-elements

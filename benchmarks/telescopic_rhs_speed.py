@@ -55,22 +55,17 @@ last evaluation, and a benchmark that repeats one state measures cache hits.  Va
   2026-11-24: with W = L^-1 B the residual is at the whole LU's level without it),
 
 All variants assemble the reduced system block by block and evaluate each material point once
-for the real and complex-step states (2026-11-24, second session; before, the full N x N mass
-matrix was formed and projected, and every point was evaluated twice; that code's own version
-of this script, run at commit f32e090, wrote ``results/telescopic_rhs_speed_f32e090.md``).
-They also share what the third session (2026-11-24) changed without a switch: the friction
-section maps in closed form, the saddle-point factor on the border columns that touch each
-block, the element convective rows from tables, the element blocks scattered in one call (the
-second session's table of this script is ``results/telescopic_rhs_speed_dc97a83.md``), and
-what the fourth changed without a switch: in the element kernel the kinematics once at the
-complex-step state, J_r in its Kronecker structure (the translational mass without the BLAS
-product, omega and eps_dot as real parts of the convective sums), the saddle-point blocks per
-element instead of per beam, the refinement residual from the blocks (the third session's
-table is ``results/telescopic_rhs_speed_af1e8ab.md``), and what the fifth to eighth changed
-without a switch: among them the constraint program on each point's own columns, the
-saddle-point blocks by W = L^-1 B, the constant boundary conditions' lift formed once, the
-micro-motion Newton's 5 x 5 solves inline (the fourth session's table is
-``results/telescopic_rhs_speed_8dbba34.md``).
+for the real and complex-step states (the full N x N mass matrix is never formed and
+projected).  They also share the improvements that have no switch: the friction section maps
+in closed form, the saddle-point factor on the border columns that touch each block, the
+element convective rows from tables, the element blocks scattered in one call; in the element
+kernel the kinematics once at the complex-step state, J_r in its Kronecker structure (the
+translational mass without the BLAS product, omega and eps_dot as real parts of the convective
+sums), the saddle-point blocks per element, the refinement residual from the blocks, the
+constraint program on each point's own columns, the saddle-point blocks by W = L^-1 B, the
+constant boundary conditions' lift formed once and the micro-motion Newton's 5 x 5 solves
+inline.  The tables this script wrote for earlier code are in the git history of
+``results/telescopic_rhs_speed.md`` and the CHANGELOG.
 
 then a cProfile of the last variant without the worker thread, grouped by what the time is
 spent on.  Ratios within one

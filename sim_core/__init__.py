@@ -12,8 +12,8 @@ folding long-boom manipulator paper (SIMULTECH 2020, the "second seed").  SI uni
 import os as _os
 
 # The models are small (50-400 coordinates): threaded BLAS only adds overhead and contention
-# (measured 62 ms vs 0.37 ms for a 200x200 LU on the 2-core machine).  A default only: a value
-# the user set is kept, and it has no effect if numpy was imported before sim_core.
+# (on a small LU the thread start-up costs far more than the factorisation).  A default only:
+# a value the user set is kept, and it has no effect if numpy was imported before sim_core.
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     _os.environ.setdefault(_var, "1")
 

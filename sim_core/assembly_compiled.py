@@ -7,9 +7,9 @@ and signs coordinates (the usual boundary conditions that fix single coordinates
 M_r[red[a], red[b]] with the factor sg[a] sg[b], and nothing where a coordinate is eliminated
 (red = -1).  The full assembly is the same scatter with red = 0..N-1, sg = 1.
 
-Adding the blocks straight into M_r replaces forming the N x N matrix and taking its sub-matrix
-(~0.3 ms at 8 sub-elements, N = 320: as much as the element kernels of a telescopic
-right-hand side).  The compiled loop is used for real blocks; complex-step states take the numpy
+Adding the blocks straight into M_r avoids forming the N x N matrix and taking its sub-matrix,
+which at the paper's discretisation would cost about as much as the element kernels
+themselves.  The compiled loop is used for real blocks; complex-step states take the numpy
 version, which is also the reference (``tests/beam/test_nonlinear_constraints.py``).
 """
 

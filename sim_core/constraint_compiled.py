@@ -5,9 +5,9 @@ The constraint rows of the telescopic scene (Zhao-Qi-Wang 2024 Section 6, Eqs. 4
 centroids and Cardan angles coincide; the luffing and telescopic cylinders as distance drivers;
 the inextensible rope as a sum of distances) are built in :mod:`sim_core.constraints` from
 material points (Eq. 6 with the moving contact coordinates of Section 5).  Evaluated in Python
-they cost ~0.4 ms per right-hand side (12 constraints, each a closure over two point
-functions) and, column by column in the structured Jacobian (:mod:`sim_core.state_jacobian`),
-~1200 such evaluations per Jacobian.  Here the same rows are one compiled program:
+they are 12 closures over two point functions each on every right-hand side and, column by
+column in the structured Jacobian (:mod:`sim_core.state_jacobian`), about a thousand such
+evaluations per Jacobian.  Here the same rows are one compiled program:
 
 * every point once, at the complex-step state Q + i h Q_dot (h = 1e-20): r, its Jacobian,
   the Cardan angles and theirs on the point's own columns (its element's coordinates and

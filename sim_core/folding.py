@@ -56,10 +56,9 @@ Departures from the PDs
     Newton) instead of :func:`sim_core.statics.constrained_static_equilibrium`, whose
     unscaled matrix is numerically singular here (cond ~ 1e19).
 
-Performance (2-core shared machine, RK45): one RHS ~8-15 ms at 8 sub-elements per boom;
-with h = 0.005 s the filter bounds |lambda| <= ~2.45/h, steps are 1e-3 ... 6e-3 s, and the
-full 45 s scene takes O(1 h) of CPU -- far beyond the default tests, which use 2 sub-elements
-per boom and compressed stages.  Static equilibrium at t = 0: ~1 min (8 sub-elements).
+Cost: with h = 0.005 s the filter bounds |lambda| <= ~2.45/h, so RK45 takes steps of
+1e-3 ... 6e-3 s, and the full 45 s scene is far beyond the default tests, which use 2
+sub-elements per boom and compressed stages (run times: docs/performance.md).
 """
 
 from __future__ import annotations

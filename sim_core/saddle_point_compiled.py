@@ -10,9 +10,8 @@ residual from the blocks, their border columns and the border rows: the non-zero
 only; ``Model.kkt_refine``, off by default: with W = L^-1 B the unrefined residual is at the
 whole matrix LU's level).  A right-hand side that is zero on a block, e.g. a unit load on a
 border coordinate, skips that block's forward solve.  As one compiled factorisation and one
-compiled solve
-the ~30 LAPACK and numpy calls of the Python version (each with its call overhead; 0.4 ms +
-0.25 ms per telescopic right-hand side at 8 sub-elements) become two.  LAPACK (dpotrf,
+compiled solve the ~30 LAPACK and numpy calls of the Python version, each with its call
+overhead, become two.  LAPACK (dpotrf,
 dtrtrs, dgetrf, dgetrs of scipy's ``cython_lapack``) is called through external symbols, as
 :mod:`sim_core.beam.element_compiled` calls dsyrk, so the functions stay cacheable.
 ``tests/telescopic/test_assembly_paths.py`` checks both against the LU of the whole matrix.
@@ -22,7 +21,7 @@ block reads only the rows of M_r its element owns, so it can be factored as soon
 element is added -- while the worker computes the later elements.  At 8 sub-elements the
 calling thread finishes its own share (constraint rows, friction maps, point effects) when
 five of the six elements are done, factors their blocks while the sixth is computed, and is
-left with one block, the border and its LU: right-hand side 1.27 -> 1.17 ms (interleaved A/B).
+left with one block, the border and its LU (benchmarks/telescopic_rhs_speed.py times it).
 The border's Schur complement is then summed as (-sum_i W_i^T W_i) + D instead of D - sum_i
 (round-off; the tests compare the two paths to 1e-12).
 """

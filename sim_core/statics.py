@@ -91,8 +91,9 @@ def _force_tangent(parts, z: np.ndarray, lam: np.ndarray, rel_step: float = 1e-6
 
     Central differences: the Newton system of stiff booms is dominated by cancellation (entries
     EA/l ~ 1e13 N/m against residuals ~ 1e5 N), and the O(h) truncation error of forward
-    differences (~1e-6 relative) made the Newton step useless at 8 sub-elements
-    (benchmarks/diagnose_static_tangent.py); the O(h^2) error of central ones does not."""
+    differences (~1e-6 relative) makes the Newton step useless at 8 sub-elements
+    (benchmarks/diagnose_static_tangent.py shows it); the O(h^2) error of central ones does
+    not."""
     n = len(z)
     h = rel_step * max(1.0, float(np.max(np.abs(z))))
     K = np.empty((n, n))
@@ -124,8 +125,8 @@ def constrained_static_equilibrium(model: Model, z0: np.ndarray, t: float = 0.0,
     than 1/16 of the Newton step: the start is outside its region of convergence), and
     ``continuation`` is on and the model has weight, the equilibrium is traced from the
     unloaded state by :func:`load_continuation`, which either reaches the full weight or raises
-    :class:`~sim_core.errors.NoStaticEquilibrium` at a limit point (issue 6: the soft booms at
-    0 deg luffing angle).
+    :class:`~sim_core.errors.NoStaticEquilibrium` at a limit point (e.g. the soft booms at 0 deg
+    luffing angle).
     """
     z = np.array(z0, float)
     n = len(z)

@@ -3,7 +3,7 @@
 The numpy version in :mod:`sim_core.beam.cardan` is the reference (and the fallback where numba
 is not installed); this is the same algebra written point by point, so that one element's 40
 quadrature points cost one compiled loop instead of ~100 small numpy operations (the section
-state was ~1/9 of a telescopic right-hand side at 8 sub-elements, ``benchmarks/profile_rhs.py``).
+state is a sizeable share of a right-hand side: ``benchmarks/profile_rhs.py``).
 Source of the formulas: Zhao, Qi, Wang (2024), Section 5, Eqs. 24-33 (see ``cardan.py``).
 Compiled once per dtype (float64 for the kinematics, complex128 for the complex-step convective
 terms; only operations that are analytic in the complex plane are used, as in ``cardan.py``).

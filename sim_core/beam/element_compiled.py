@@ -4,8 +4,9 @@
 (mass centre on the reference line, y_c = z_c = 0), Elasticity, StressFilter(h) and Gravity(g)
 of :mod:`sim_core.effects` costs ~100 small numpy operations per element (a real
 ``SplineElement.evaluate``, a complex-step one for the convective terms, the lazily formed
-Jacobians J_r, J_w, B_xi, B_s and the effect sums; ~1.2 ms at 9 nodes, 40 Gauss points, 59
-coordinates).  This is the same algebra as one compiled pass over the quadrature points:
+Jacobians J_r, J_w, B_xi, B_s and the effect sums: at 9 nodes, 40 Gauss points and 59
+coordinates the call overhead dominates).  This is the same algebra as one compiled pass over
+the quadrature points:
 
 * kinematics at the Gauss points (Zhao, Qi, Wang (2024), Sections 3-5): spline basis rows with
   the powers of the sub-element length l (Eqs. 5, 10-11, cached tables of the element), r and
@@ -29,9 +30,8 @@ made.  The mass matrix is one BLAS product A^T A of the weighted Jacobian rows J
 all points stacked into a (G k, n_coords) matrix (k = 3 for the rotary inertia, + 4 for the
 filter) plus the translational part sum w rhoA J_r^T J_r formed in its Kronecker structure
 (J_r = X_0 (x) I_3 on the position coefficients: a (n+4) x (n+4) sum instead of 3 rows per
-point in the product, the other rows scaled in place for it; 880 -> ~610 us per telescopic
-batch of 6 elements); the force one
-matrix-vector product of the stacked unweighted rows (J_r, J_w, B_s) with the per-row loads.
+point in the product, the other rows scaled in place for it); the force one matrix-vector
+product of the stacked unweighted rows (J_r, J_w, B_s) with the per-row loads.
 
 The numpy path (``Model.element_mass_force``) stays the reference and the fallback where numba
 is not installed (``AVAILABLE`` is False then); ``tests/beam/test_element_compiled.py`` checks

@@ -234,7 +234,7 @@ class SplineElement:
 
     # -- kinematics --------------------------------------------------------------------
     #
-    # Implementation (performance, benchmarks/README.md).  For every point the element needs
+    # Implementation (performance: docs/performance.md).  For every point the element needs
     # the basis rows
     #     position  X = [phi_k l^(p-k), k = 0..3]   (r and its first three s-derivatives)
     #               and the l-derivatives (p - k) phi_k l^(p-k-1), k = 0..2, at fixed xi
