@@ -1,9 +1,11 @@
-"""Command line: ``boom-sim run|list|describe|plot``.
+"""Command line: ``boom-sim run|sweep|list|describe|plot``.
 
 Errors in the scene (or an unreadable result file for ``plot``) exit with status 2 and a
 one-line message; a failed solve exits with status 3 and a one-line message (time and reason),
 after writing summary.json with the error and, if the solver attached one to the
-SimulationError (``.result``), the partial result.npz.
+SimulationError (``.result``), the partial result.npz.  ``sweep`` (:mod:`sim_core.sweep`) exits
+with status 2 for an invalid case or grid before running anything, 3 if any case failed (the
+others still run) and 130 when interrupted (finished cases and the summary are kept).
 """
 
 from __future__ import annotations
@@ -11,6 +13,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+import time
 from pathlib import Path
 
 from .errors import SceneError, SimulationError
@@ -213,12 +216,67 @@ def cmd_plot(args) -> int:
     return 0
 
 
+def cmd_sweep(args) -> int:
+    from .sweep import SweepError, parse_grid, run_sweep
+    grid = parse_grid(args.grid)
+    fixed = _overrides(args.set)
+    both = sorted(set(grid) & set(fixed))
+    if both:
+        raise SceneError(f"--grid {both[0]} and --set {both[0]}: a key is either swept or fixed")
+    t0 = time.perf_counter()
+    try:
+        rows = run_sweep(args.scene, grid, args.out, fixed=fixed, address=args.address,
+                         workers=args.workers, quiet=args.quiet, plots=args.plots)
+    except SweepError as exc:
+        raise _InputError(str(exc)) from None
+    except KeyboardInterrupt:
+        print(f"boom-sim: sweep interrupted; finished cases and {args.out}/summary.csv kept "
+              f"(run the same command again to resume)", file=sys.stderr)
+        return 130
+    st = [r["status"] for r in rows]
+    out = Path(args.out)
+    files = ["summary.csv"] + [f for f in ("summary.parquet", "summary.png") if (out / f).exists()]
+    print(f"{args.scene}: {len(rows)} cases in {time.perf_counter() - t0:.1f} s wall: "
+          f"{st.count('ok')} ok, {st.count('failed')} failed, {st.count('skipped')} skipped; "
+          f"wrote {out}/{{{','.join(files)}}}")
+    failed = [r for r in rows if r["status"] == "failed"]
+    for r in failed:
+        print(f"boom-sim: case {r['case']} failed: {r['error_type']}: {r['error']}", file=sys.stderr)
+    return 3 if failed else 0
+
+
 class _InputError(Exception):
     """A bad command-line input other than a scene (exit status 2)."""
 
 
+_SWEEP_HELP = """\
+Run the Cartesian product of the --grid values as Ray tasks, one simulation per task (1 CPU
+each), and write into --out: one folder per case (named from its overrides; result.npz and
+summary.json, written under a temporary name and renamed into place), summary.csv (Parquet
+too if pyarrow is installed: overrides, status ok/failed/skipped, error type and message,
+wall time, steps, scalar outcomes) and summary.png (each outcome against the first grid key).
+Every case is validated before anything runs.  Running the same command again skips the
+cases already done; a failed case is recorded and the others go on; Ctrl-C keeps the
+finished cases.  Needs Ray (pip install 'telescopic-boom-sim[cluster]').
+
+example:
+  boom-sim sweep telescopic_extraction_rl --grid payload.mass=20000,25000,30000 \\
+      --grid booms.luffing_angle_deg=45,60,75 --out sweep_rl --workers 2
+"""
+
+_EPILOG = """\
+sweeps:
+  boom-sim sweep SCENE --grid KEY=V1,V2,... [--grid ...] [--set KEY=VALUE] --out DIR
+                 [--address ADDR] [--workers N]
+  runs every combination of the grid values as a Ray task (local Ray by default, --address
+  joins a cluster), writes one result folder per case, DIR/summary.csv and DIR/summary.png;
+  re-running skips finished cases.  Details: boom-sim sweep --help.
+"""
+
+
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="boom-sim", description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(prog="boom-sim", description=__doc__.splitlines()[0],
+                                epilog=_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="cmd", required=True)
     r = sub.add_parser("run", help="simulate a scene, write result.npz, summary.json, figures")
     r.add_argument("scene", help="shipped scene name or path to a TOML scene")
@@ -227,6 +285,24 @@ def main(argv: list[str] | None = None) -> int:
     r.add_argument("--quiet", action="store_true", help="no progress bar")
     r.add_argument("--no-plots", action="store_true")
     r.set_defaults(func=cmd_run)
+    sw = sub.add_parser("sweep", help="run the Cartesian product of scene overrides as Ray tasks",
+                        description=_SWEEP_HELP, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sw.add_argument("scene", help="shipped scene name or path to a TOML scene")
+    sw.add_argument("--grid", action="append", required=True, metavar="KEY=V1,V2,...",
+                    help="a swept scene key and its values (repeat for more keys; TOML arrays "
+                         "and quoted strings may contain commas)")
+    sw.add_argument("--set", action="append", metavar="KEY=VALUE",
+                    help="override a scene value in every case")
+    sw.add_argument("--out", required=True, help="output folder (created; reused to resume)")
+    sw.add_argument("--address", default=None,
+                    help="join this Ray cluster (Ray's address format, e.g. auto or "
+                         "ray://head:10001); default: start a local Ray")
+    sw.add_argument("--workers", type=int, default=None, metavar="N",
+                    help="at most N cases at a time (local Ray: N CPUs; default: all cores)")
+    sw.add_argument("--plots", action="store_true",
+                    help="also write the figures of 'run' into every case folder")
+    sw.add_argument("--quiet", action="store_true", help="no progress bar")
+    sw.set_defaults(func=cmd_sweep)
     sub.add_parser("list", help="shipped scenes").set_defaults(func=cmd_list)
     d = sub.add_parser("describe", help="resolved scene, effects and DOF count")
     d.add_argument("scene")
