@@ -149,6 +149,19 @@ def ok(b) -> bool:
     return bool(b)
 
 
+def moment_row(figure: str, where: str, c: np.ndarray, sign: int) -> Row:
+    """'Only the moment about e_t, of this sign': m_t of the sign at >= 95 % of the times,
+    the other two components below 5 % of max |m_t|; ``c`` (n_t, 6) a region's contact()."""
+    mt = np.max(np.abs(c[:, 4]))
+    other = max(np.max(np.abs(c[:, 3])), np.max(np.abs(c[:, 5])))
+    share = frac(sign * c[:, 4] > 0)
+    word, rel = ("positive", ">") if sign > 0 else ("negative", "<")
+    return Row(figure, f"{where}: only the moment about e_t, {word}",
+               f"max |m_t| = {mt / 1e3:.0f} kN m, m_t {rel} 0 at {100 * share:.0f} %, other "
+               f"components <= {other / max(mt, 1e-30):.1e} of it",
+               ok(mt > 1e3 and other < 0.05 * mt and share >= 0.95))
+
+
 def extraction_rows(res: Result) -> list[Row]:
     t = res.t
     Ft = res["telescopic_cylinder_force"]
@@ -222,26 +235,14 @@ def extraction_rows(res: Result) -> list[Row]:
                     f"(f_b(0) = {I23[0, 2] / 1e3:.0f} kN, >= 0 until {last_pos:.1f} s; "
                     f"f_b(16 s) = {at(res, I23[:, 2], 16.0) / 1e3:.0f} kN)",
                     ok(frac(I23[allt, 2] < 0) >= 0.95)))
-    mt = np.max(np.abs(I23[:, 4]))
-    other = max(np.max(np.abs(I23[:, 3])), np.max(np.abs(I23[:, 5])))
-    rows.append(Row("25a", "Boom 2, inner contact point: only the moment about e_t, positive",
-                    f"max |m_t| = {mt / 1e3:.0f} kN m, m_t > 0 at "
-                    f"{100 * frac(I23[allt, 4] > 0):.0f} %, other components <= "
-                    f"{other / max(mt, 1e-30):.1e} of it",
-                    ok(mt > 1e3 and other < 0.05 * mt and frac(I23[allt, 4] > 0) >= 0.95)))
+    rows.append(moment_row("25a", "Boom 2, inner contact point", I23[allt], +1))
     rows.append(Row("24b", "Boom 3, outer contact point: axial force negative",
                     f"f_s < 0 at {100 * frac(II23[slide, 0] < 0):.0f} % of 1-15.5 s",
                     ok(frac(II23[slide, 0] < 0) >= 0.95)))
     rows.append(Row("24b", "Boom 3, outer contact point: vertical force positive",
                     f"f_b > 0 at {100 * frac(II23[allt, 2] > 0):.0f} % of 0-20 s",
                     ok(frac(II23[allt, 2] > 0) >= 0.95)))
-    mt2 = np.max(np.abs(II23[:, 4]))
-    other2 = max(np.max(np.abs(II23[:, 3])), np.max(np.abs(II23[:, 5])))
-    rows.append(Row("25b", "Boom 3, outer contact point: only the moment about e_t, negative",
-                    f"max |m_t| = {mt2 / 1e3:.0f} kN m, m_t < 0 at "
-                    f"{100 * frac(II23[allt, 4] < 0):.0f} %, other components <= "
-                    f"{other2 / max(mt2, 1e-30):.1e} of it",
-                    ok(mt2 > 1e3 and other2 < 0.05 * mt2 and frac(II23[allt, 4] < 0) >= 0.95)))
+    rows.append(moment_row("25b", "Boom 3, outer contact point", II23[allt], -1))
 
     def trend(y):
         s = smooth(t, np.abs(y))
