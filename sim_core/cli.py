@@ -102,6 +102,8 @@ def cmd_run(args) -> int:
     print(f"{scene['name']}: {scene['solver']['t_end']:g} s simulated in {wall:.1f} s wall "
           f"(RTF {rtf:.3g})" + (f"; {work}" if work else "") + f"; wrote {out}/result.npz, "
           f"summary.json" + (f", {len(figs)} figures" if figs else ""))
+    if result.suspect:                 # a cheap self-check failed (summary.json: failed_checks)
+        print(f"boom-sim: warning: {result.suspect_note()}", file=sys.stderr)
     return 0
 
 

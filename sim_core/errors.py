@@ -54,3 +54,48 @@ class NoStaticEquilibrium(SimulationError):
         super().__init__(t, reason or (
             "no static equilibrium: the equilibrium path under the weight turns back at a limit "
             f"point at {self.load_factor_max:.3g} x the full weight (load continuation)"))
+
+
+class ElementEvaluationError(SimulationError):
+    """The element batch (mass matrices and forces) could not be evaluated at a state: the
+    compiled kernel divided by zero or met a non-finite value (e.g. a state far off the
+    solution, where a sub-element has collapsed).  Raised on the calling thread also where the
+    batch ran on the element worker thread; the integrator treats it as a failed stage
+    evaluation (the step is rejected and retried smaller)."""
+
+
+class StalledIntegration(SimulationError):
+    """The integration stopped making progress: its accepted steps stayed so short that the
+    rest of the run would take more steps than any run is allowed, or more wall time than its
+    budget leaves (see :class:`sim_core.simulate.StallMonitor`).
+
+    Attributes
+    ----------
+    mean_step : float
+        Mean accepted step over the monitored window, s.
+    window : int
+        Accepted steps in that window.
+    """
+
+    def __init__(self, t: float, reason: str, mean_step: float, window: int, step=None,
+                 last_state=None):
+        self.mean_step = float(mean_step)
+        self.window = int(window)
+        super().__init__(t, reason, step=step, last_state=last_state)
+
+
+class SuspectResult(SimulationError):
+    """A finished run failed its own result checks (:func:`sim_core.simulate.check_result`) by
+    so much that its outputs are not a solution of the model: e.g. its energy grew far beyond
+    what the integration tolerance allows while nothing fed energy in.  The result is attached
+    as ``.result`` (its ``error`` set), as for a failed solve.
+
+    Attributes
+    ----------
+    checks : dict
+        The failed checks: name -> {"value": ..., "limit": ..., "what": ...}.
+    """
+
+    def __init__(self, t: float, reason: str, checks: dict, last_state=None):
+        self.checks = dict(checks)
+        super().__init__(t, reason, last_state=last_state)

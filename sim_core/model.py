@@ -25,6 +25,7 @@ from .assembly_compiled import scatter_add, scatter_add_blocks
 from .beam.moving_node_beam import Beam
 from .constraints import constraint_terms, kkt_accelerations, kkt_factor
 from .effects import Effect, ElementContext, Gravity, PointLoad, StressFilter
+from .errors import ElementEvaluationError
 
 _CSTEP = 1e-20   # complex-step size (no subtractive cancellation, any tiny value works)
 
@@ -98,17 +99,19 @@ class Model:
     # (point_effects.CompiledPointEffects); False: each effect's local() in Python (the reference)
     point_effects_compiled: bool = True
     # the element batch on a worker thread while the constraint rows are evaluated
-    # (_element_blocks_started); False: on the calling thread
+    # (_element_blocks_started), where the model's governor allows a helper thread (at least
+    # two cores in the affinity set, SIM_CORE_ELEMENT_WORKER, and the worker getting a core of
+    # its own: Model.governor, element_worker.Governor); False: on the calling thread
     element_thread: bool = True
-    # after handing the batch to the worker, release the GIL once (time.sleep(0)) so that the
-    # worker takes it at once: otherwise it waits while this thread runs the Python of the
-    # constraint rows (measured 2026-11-24: the batch started 0.27 ms after submission, 0.08 ms
-    # with the hand-over; the element batch itself takes ~0.9 ms at 8 sub-elements)
+    # after handing the batch to the thread pool, release the GIL once (time.sleep(0)) so that
+    # the pool's thread takes it at once: otherwise it waits while this thread runs the Python
+    # of the constraint rows (the batch started 0.27 ms after submission, 0.08 ms with the
+    # hand-over; the element batch itself takes ~0.9 ms at 8 sub-elements)
     element_yield: bool = True
     # with element_thread: hand the batch to a persistent compiled worker through a mailbox and
     # an atomic state word (beam/element_worker.py: no queue, no wake-up, no GIL hand-over;
-    # 1.46 -> 1.39 ms per right-hand side, interleaved A/B 2026-11-24; its result arrays are the
-    # worker's mailbox, valid until the next batch is started); False: the thread pool
+    # 1.46 -> 1.39 ms per right-hand side, interleaved A/B; its result arrays are the worker's
+    # mailbox, valid until the next batch is started); False: the thread pool
     element_spin: bool = True
     # with element_spin and kkt_blocks: add each element into M_r and factor its block as soon
     # as the worker publishes it, while the worker computes the next elements
@@ -382,13 +385,27 @@ class Model:
             return None
         batch, kw = plan
         QE, QDE = Q[self._element_idx], Qd[self._element_idx]
-        if self.element_thread and self.element_spin and element_worker.AVAILABLE:
+        if self.element_thread and self.element_spin and element_worker.AVAILABLE \
+                and self.governor().allowed:
             worker = self.__dict__.get("_spin_worker")
             if worker is None or worker.batch is not batch:
+                if worker is not None:
+                    worker.stop()
                 worker = self._spin_worker = element_worker.ElementWorker(batch, *QE.shape)
-            worker.submit(QE, QDE, kw["h"], kw["g"])
-            return _WorkerBatch(worker)
-        return self._run(lambda: batch(QE, QDE, kw["h"], kw["g"]))
+            if self.governor().use_worker(worker):
+                worker.submit(QE, QDE, kw["h"], kw["g"], t)
+                return _WorkerBatch(worker)
+            return _inline(lambda: batch(QE, QDE, kw["h"], kw["g"]), t)
+        return self._run(lambda: batch(QE, QDE, kw["h"], kw["g"]), t)
+
+    def governor(self) -> element_worker.Governor:
+        """Whether the element batches use a helper thread (:class:`element_worker.Governor`:
+        the cores in the affinity set, ``SIM_CORE_ELEMENT_WORKER`` and whether the worker gets
+        a core of its own), one per model."""
+        gov = self.__dict__.get("_governor")
+        if gov is None:
+            gov = self._governor = element_worker.Governor()
+        return gov
 
     def _element_differences_started(self, Q, Qd, Qdd, steps):
         """Start the structured Jacobian's element columns, element by element
@@ -435,17 +452,24 @@ class Model:
             return wait()                   # the worker's error, if any; finite-checked
         return finish
 
-    def _run(self, job):
-        """job() on the element worker thread with ``element_thread`` (a function that waits
-        for it and checks its result for non-finite values on the calling thread), else at
-        once."""
-        if not self.element_thread:
-            out = job()
-            return lambda: _checked(out)
+    def _run(self, job, t: float = float("nan")):
+        """job() on the element worker thread with ``element_thread`` where the governor allows
+        a helper thread (a function that waits for it and checks its result for non-finite
+        values on the calling thread), else at once; a division by zero or an overflow in the
+        batch is an :class:`ElementEvaluationError` at time t."""
+        if not (self.element_thread and self.governor().threads()):
+            return _inline(job, t)
         future = _element_worker().submit(job)
         if self.element_yield:
             time.sleep(0)       # hand the GIL over now (see element_yield)
-        return lambda: _checked(future.result())
+
+        def wait():
+            try:
+                out = future.result()
+            except (ZeroDivisionError, OverflowError) as exc:
+                raise _evaluation_error(exc, t) from exc
+            return _checked(out)
+        return wait
 
     def _element_batch_plan(self, Q, Qd):
         """(ElementBatch, effect arguments of this call) or None where the batch does not cover
@@ -853,6 +877,22 @@ class _WorkerBatch:
 
     def __call__(self):
         return _checked(self.worker.result())
+
+
+def _evaluation_error(exc: BaseException, t: float) -> ElementEvaluationError:
+    return ElementEvaluationError(t, f"element batch failed: {type(exc).__name__}: {exc}")
+
+
+def _inline(job, t: float):
+    """job() (an element batch) at once on the calling thread; a function that returns its
+    result finite-checked (as :func:`_checked`).  A division by zero or an overflow in the
+    compiled kernel is an :class:`ElementEvaluationError` at time t, as where the batch runs on
+    the worker."""
+    try:
+        out = job()
+    except (ZeroDivisionError, OverflowError) as exc:
+        raise _evaluation_error(exc, t) from exc
+    return lambda: _checked(out)
 
 
 def _checked(out):

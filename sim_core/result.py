@@ -105,6 +105,27 @@ class Result:
     def __contains__(self, name: str) -> bool:
         return name in self.outputs
 
+    @property
+    def suspect(self) -> bool:
+        """The run finished but failed one of its own result checks (``stats["checks"]``,
+        :func:`sim_core.simulate.check_result`): its outputs may be wrong."""
+        return bool(self.stats.get("suspect", False))
+
+    def failed_checks(self) -> dict:
+        """The failed result checks: name -> {value, limit, fail_limit, ok, gross, what}."""
+        checks = self.stats.get("checks") or {}
+        return {k: c for k, c in checks.items() if not c.get("ok", True)}
+
+    def suspect_note(self) -> str:
+        """One line naming the failed checks with their values and limits ("" if none), e.g.
+        for the command line: ``suspect result: energy_balance = 0.35 > 0.1 (energy drift /
+        exchanged energy ...)``."""
+        failed = self.failed_checks()
+        if not failed:
+            return ""
+        return "suspect result: " + "; ".join(
+            f"{k} = {c['value']:.3g} > {c['limit']:.3g} ({c['what']})" for k, c in failed.items())
+
     def keys(self):
         return self.outputs.keys()
 

@@ -393,9 +393,11 @@ def simulate_telescopic(p: TelescopicParams, t_end: float = 20.0, n_output: int 
     m = ts.model
     z0, _ = initial_equilibrium(ts)
     y0 = np.concatenate([z0, 0 * z0])
+    from .simulate import telescopic_energy_check
     return run_with_partial(
         lambda: integrate(m, y0, sol["t_end"], sol, progress),
-        lambda t, ys, stats, err: _telescopic_result(ts, t, ys, stats, err))
+        lambda t, ys, stats, err: _telescopic_result(ts, t, ys, stats, err),
+        check=lambda res: telescopic_energy_check(ts, res))
 
 
 def _telescopic_result(ts: TelescopicSystem, t, ys, stats, error):
@@ -448,6 +450,9 @@ def _telescopic_result(ts: TelescopicSystem, t, ys, stats, error):
         out["outer_contact_s"].append(Q[ts.s3_index[1:]])
         out["constraint_violation"].append(np.max(np.abs(m.constraint_violation(tk, z, zd))))
     outputs = {k: np.array(v, dtype=float) for k, v in out.items()}
+    # the integrated states at the output times (the energy check of the result re-evaluates
+    # the energies from them, simulate.telescopic_energy_check)
+    outputs["state"] = np.asarray(ys, dtype=float)
     stats["n_dof"] = int(n)
     scene = {"name": "telescopic", "params": {k: v for k, v in p.__dict__.items() if k != "sections"}}
     return Result(t, outputs, stats, scene, error)
