@@ -11,8 +11,10 @@ Evaluation protocol (identical for every controller)
 * Env: ``boom_env/TelescopicExtraction-v0`` (modal ROM of the full model, paper scene: 25 t,
   60 deg, L_s 2 -> 8 m, dt = 0.05 s, t_max = 30 s) with ``tol_deflection = 0``: the success
   termination is switched off so that every controller runs the whole 30 s and the vibration
-  after the stop is observed.  The PPO policy acts (deterministically) for the whole episode; a
-  scripted schedule commands a = 0 after its end.
+  after the stop is observed; ``reward_scale = 1``: ``episode_return`` is in the env's
+  unscaled reward units (the env's default scale 0.01 divides it by 100).  The PPO policy
+  acts (deterministically) for the whole episode; a scripted schedule commands a = 0 after
+  its end.
 * ``time_to_target_s``: first time after which |L_s - L*| <= 1 cm for the rest of the episode.
 * ``stop_time_s``: first time after which additionally |dL_s/dt| <= 5 mm/s (the env's speed
   tolerance) for the rest of the episode.
@@ -71,11 +73,12 @@ class Trace:
 
 
 def make_eval_env(**kwargs):
-    """The evaluation env: the registered extraction env with success termination off."""
+    """The evaluation env: the registered extraction env with success termination off and the
+    unscaled reward (``reward_scale = 1``); ``kwargs`` override or add constructor arguments."""
     import gymnasium as gym
 
     import boom_env  # noqa: F401
-    return gym.make(ENV_ID, tol_deflection=0.0, **kwargs)
+    return gym.make(ENV_ID, **{"tol_deflection": 0.0, "reward_scale": 1.0, **kwargs})
 
 
 def telescopic_force(env, a: float) -> float:

@@ -35,12 +35,16 @@ COLUMNS = (("time_to_target_s", "time to target (s)", "{:.2f}"),
 def read_curve(run: Path) -> np.ndarray:
     with open(run / "learning_curve.csv") as f:
         rows = list(csv.reader(f))[1:]
+    if not rows:
+        raise ValueError(f"{run / 'learning_curve.csv'}: no finished episode (train for more "
+                         "than one episode, 600 env steps per env)")
     return np.array([[float(x) for x in r] for r in rows])
 
 
 def cubic_training_return(env_kwargs: dict | None = None) -> float:
     """Return of the paper's cubic schedule from 2 m in the *training* env (the registered env
-    with the run's env arguments, default agents.train_ppo.TRAIN_ENV_KWARGS).  Runs with random
+    with the run's env arguments, default agents.train_ppo.TRAIN_ENV_KWARGS; reward scale 1
+    unless they set it, as agents.train_ppo.train trains).  Runs with random
     start strokes (agents.wrappers.RandomStart) are not strictly comparable with it; for a
     residual run it is the return of the residual policy's u = 0."""
     import gymnasium as gym
@@ -50,7 +54,8 @@ def cubic_training_return(env_kwargs: dict | None = None) -> float:
     from .evaluate import ENV_ID, run_episode, scripted_policy
     from .schedules import cubic
     from .train_ppo import TRAIN_ENV_KWARGS
-    env = gym.make(ENV_ID, **(TRAIN_ENV_KWARGS if env_kwargs is None else env_kwargs))
+    env = gym.make(ENV_ID, **{"reward_scale": 1.0,
+                              **(TRAIN_ENV_KWARGS if env_kwargs is None else env_kwargs)})
     u = env.unwrapped
     pol = scripted_policy(cubic(), u.dt, u.a_max, int(round(u.t_max / u.dt)))
     return run_episode(env, pol, 0).total_return

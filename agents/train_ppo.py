@@ -1,6 +1,7 @@
 """Train the PPO baseline on ``boom_env/TelescopicExtraction-v0``.
 
     python -m agents.train_ppo --timesteps 300000 --seed 0 --out agents/runs/seed0
+    python -m agents.train_ppo --seeds 0 1 2 --ray [--address ADDR] --out agents/runs
 
 The policy is by default a *residual* on the paper's cubic schedule (``--residual cubic``,
 ``agents.wrappers.ResidualOnSchedule``): the env action is the schedule's feed-forward
@@ -22,6 +23,16 @@ periodic checkpoints, and on exit:
   training episodes (the stochastic policy's undiscounted, unnormalised env return) and their
   success rate.
 
+PPO hyper-parameters: the entry of ``boom_env/TelescopicExtraction-v0`` in
+``agents/hyperparams/ppo.yml``, the RL Zoo file (``--hyperparams`` another one; ``--set``
+overrides single values).
+
+``--seeds S1 S2 ...`` trains one run per seed into ``OUT/seed<S>`` and writes the report of
+``agents.report`` (learning_curve.png, comparison.md) into OUT.  With ``--ray`` each seed is a
+Ray task (``ray.init()`` on this machine, or the cluster at ``--address``; ray is imported only
+then): SB3 trains inside the task, Ray only schedules, and the task hands the run's files back
+to be written here, so the folders are the same as without Ray.
+
 Training is reproducible for a given seed up to the floating-point non-determinism of torch:
 the env, the policy initialisation and the action noise are seeded (``set_random_seed``),
 torch runs single-threaded.
@@ -40,14 +51,85 @@ from pathlib import Path
 import numpy as np
 
 ENV_ID = "boom_env/TelescopicExtraction-v0"
+# PPO hyper-parameters: the RL Zoo file shipped with the package (single source: RL Zoo reads
+# the same file with ``--conf-file``), its entry for ENV_ID.  The reasons for the values are
+# in the file.
+HYPERPARAMS_FILE = Path(__file__).with_name("hyperparams") / "ppo.yml"
+# keys of an RL Zoo entry that are not PPO constructor arguments and that train() handles
+ZOO_KEYS = ("n_envs", "n_timesteps", "policy", "normalize", "policy_kwargs")
 
-# PPO hyper-parameters (SB3 defaults except where the task asks otherwise): episodes are up to
-# 600 control steps and the success bonus comes after ~300, so a long horizon (gamma 0.995,
-# 1/(1-gamma) = 200 steps = 10 s) and GAE lambda 0.98; a small initial action noise
-# (log std -1: std 0.37 of a_max) because the tip responds to the jerk of the commands.
-HYPER = dict(n_steps=1024, batch_size=256, n_epochs=10, learning_rate=3e-4, gamma=0.995,
-             gae_lambda=0.98, clip_range=0.2, ent_coef=0.0, max_grad_norm=0.5)
-POLICY_KWARGS = dict(net_arch=dict(pi=[64, 64], vf=[64, 64]), log_std_init=-1.0)
+
+def load_hyperparams(path: str | os.PathLike = HYPERPARAMS_FILE, env_id: str = ENV_ID) -> dict:
+    """The RL Zoo hyper-parameter entry of ``env_id`` in the yml file ``path`` (a dict of
+    RL Zoo keys: n_envs, n_timesteps, policy, normalize, policy_kwargs and PPO arguments)."""
+    import yaml
+    with open(path) as f:
+        table = yaml.safe_load(f)
+    if not isinstance(table, dict) or env_id not in table:
+        raise ValueError(f"{path}: no entry for env id {env_id!r} (entries: "
+                         f"{sorted(table) if isinstance(table, dict) else 'none'})")
+    return dict(table[env_id])
+
+
+def ppo_settings(entry: dict) -> tuple[dict, dict, dict, int]:
+    """:func:`zoo_settings` of an RL Zoo PPO entry."""
+    from stable_baselines3 import PPO
+    return zoo_settings(entry, PPO)
+
+
+def zoo_settings(entry: dict, algo) -> tuple[dict, dict, dict, int]:
+    """Split an RL Zoo entry for the SB3 class ``algo`` into (constructor arguments,
+    policy_kwargs, VecNormalize arguments (empty: no normalisation), n_envs the entry is meant
+    for).  Values follow RL Zoo's conventions: ``normalize`` true / false / a mapping of
+    VecNormalize arguments (its gamma is the algorithm's), ``policy_kwargs`` a mapping (RL
+    Zoo's string form is not read here), ``learning_rate`` and ``clip_range`` a number or
+    ``"lin_<x>"`` (linear decay from x to 0), ``train_freq`` a number or a list."""
+    import inspect
+    allowed = set(inspect.signature(algo.__init__).parameters) - {"self", "policy", "env",
+                                                                   "policy_kwargs"}
+    entry = dict(entry)
+    unknown = set(entry) - allowed - set(ZOO_KEYS)
+    if unknown:
+        raise ValueError(f"hyper-parameters {sorted(unknown)}: not supported here (allowed "
+                         f"for {algo.__name__}: {sorted(set(ZOO_KEYS) | allowed)})")
+    policy = entry.pop("policy", "MlpPolicy")
+    if policy != "MlpPolicy":
+        raise ValueError(f"policy = {policy!r}: allowed 'MlpPolicy'")
+    n_envs = entry.pop("n_envs", 1)
+    if not (isinstance(n_envs, int) and n_envs >= 1):
+        raise ValueError(f"n_envs = {n_envs!r}: allowed integers >= 1")
+    entry.pop("n_timesteps", None)
+    norm = entry.pop("normalize", False)
+    if not isinstance(norm, (bool, dict)):
+        raise ValueError(f"normalize = {norm!r}: allowed true, false or a yml mapping of "
+                         "VecNormalize arguments")
+    vecnorm = {} if norm is False else {"norm_obs": True, "norm_reward": True,
+                                        **(norm if isinstance(norm, dict) else {})}
+    policy_kwargs = entry.pop("policy_kwargs", None) or {}
+    if not isinstance(policy_kwargs, dict):
+        raise ValueError(f"policy_kwargs = {policy_kwargs!r}: write it as a yml mapping")
+    for key in ("learning_rate", "clip_range"):
+        v = entry.get(key)
+        if isinstance(v, str):
+            kind, _, x = v.partition("_")
+            if kind != "lin":
+                raise ValueError(f"{key} = {v!r}: allowed a number or 'lin_<x>'")
+            entry[key] = _linear(float(x))
+    if isinstance(entry.get("train_freq"), list):
+        entry["train_freq"] = tuple(entry["train_freq"])
+    return entry, dict(policy_kwargs), vecnorm, n_envs
+
+
+def _linear(x0: float):
+    """Linear decay x0 * progress_remaining (RL Zoo's 'lin_<x>'), picklable for model.save."""
+    import functools
+    return functools.partial(_scaled_progress, x0)
+
+
+def _scaled_progress(x0: float, progress_remaining: float) -> float:
+    return x0 * progress_remaining
+
+
 # Training env: the registered env with a reachable success.  Its default success needs the tip
 # settled to 0.2 mm and 2 mm/s; with the 0.7 % modal damping at L_s = 8 m an extraction that
 # leaves ~1 mm of vibration (the cubic schedule does) takes ~80 s to get there, longer than the
@@ -156,11 +238,19 @@ def train(timesteps: int, seed: int, out: str | os.PathLike, n_envs: int | None 
           random_start: float = 0.0, action_repeat: int = 1,
           residual: str | None = None, residual_scale: float = 0.25,
           residual_omega: float = 1.0, residual_w_track: float = 1.0,
-          obs_offset: float = 0.0) -> Path:
+          obs_offset: float = 0.0,
+          hyperparams: str | os.PathLike | dict = HYPERPARAMS_FILE) -> Path:
     """Train and save; returns the path of the saved model.  ``residual`` = a schedule name of
     ``agents.schedules`` makes the policy a residual on that schedule with tracking feedback
     (``agents.wrappers.ResidualOnSchedule``: scale, feedback frequency rad/s and the weight of
-    the tracking term of the training reward, see RESIDUAL_ENV_KWARGS)."""
+    the tracking term of the training reward, see RESIDUAL_ENV_KWARGS).  PPO settings: the
+    ENV_ID entry of the RL Zoo file ``hyperparams`` (:func:`load_hyperparams`; or that entry
+    itself, a dict), then
+    ``hyper_overrides`` / ``policy_overrides``; its ``n_steps`` is per env for the entry's
+    ``n_envs``, rescaled so that a rollout has the same size with ``n_envs`` envs.  The env's
+    reward scale is 1 unless ``env_kwargs`` sets it: VecNormalize divides the rewards by the
+    running std of the return, so the scale does not change the learning, and the learning
+    curve stays in the unscaled units of agents/README.md."""
     import torch
     from stable_baselines3 import PPO
     from stable_baselines3.common.callbacks import CallbackList, CheckpointCallback
@@ -180,7 +270,11 @@ def train(timesteps: int, seed: int, out: str | os.PathLike, n_envs: int | None 
     torch.set_num_threads(1)
     set_random_seed(seed)
     default_env = RESIDUAL_ENV_KWARGS if residual else TRAIN_ENV_KWARGS
-    env_kwargs = dict(default_env if env_kwargs is None else env_kwargs)
+    env_kwargs = {"reward_scale": 1.0, **(default_env if env_kwargs is None else env_kwargs)}
+    entry = hyperparams if isinstance(hyperparams, dict) else load_hyperparams(hyperparams)
+    hyper, policy_kwargs, vecnorm, zoo_n_envs = ppo_settings(entry)
+    hyper.update(hyper_overrides or {})
+    policy_kwargs.update(policy_overrides or {})
     if sum(bool(x) for x in (du_max, action_repeat > 1, residual)) > 1:
         raise ValueError("du_max, action_repeat > 1 and residual: choose one action parameterisation")
     res = None
@@ -196,10 +290,10 @@ def train(timesteps: int, seed: int, out: str | os.PathLike, n_envs: int | None 
            for i in range(n_envs)]
     venv = SubprocVecEnv(fns, start_method="spawn") if vec == "subproc" and n_envs > 1 else DummyVecEnv(fns)
     venv.seed(seed)
-    venv = VecNormalize(venv, norm_obs=True, norm_reward=True, gamma=HYPER["gamma"], clip_obs=10.0)
-    hyper = {**HYPER, **(hyper_overrides or {})}
-    policy_kwargs = {**POLICY_KWARGS, **(policy_overrides or {})}
-    hyper["n_steps"] = max(64, hyper["n_steps"] * 2 // n_envs)   # same rollout size per update
+    if vecnorm:
+        venv = VecNormalize(venv, gamma=hyper.get("gamma", 0.99), **vecnorm)
+    # same rollout size per update as the entry's n_steps x n_envs
+    hyper["n_steps"] = max(64, hyper.get("n_steps", 2048) * zoo_n_envs // n_envs)
     if tensorboard:
         try:
             import tensorboard  # noqa: F401
@@ -225,8 +319,9 @@ def train(timesteps: int, seed: int, out: str | os.PathLike, n_envs: int | None 
         path = out / "model.zip"
         model.save(str(out / "model.tmp.zip"))
         os.replace(out / "model.tmp.zip", path)
-        venv.save(str(out / "model_vecnormalize.tmp.pkl"))
-        os.replace(out / "model_vecnormalize.tmp.pkl", out / "model_vecnormalize.pkl")
+        if vecnorm:
+            venv.save(str(out / "model_vecnormalize.tmp.pkl"))
+            os.replace(out / "model_vecnormalize.tmp.pkl", out / "model_vecnormalize.pkl")
         import json
         from .evaluate import atomic_write_text
         atomic_write_text(out / "model_meta.json", json.dumps(
@@ -244,6 +339,51 @@ def train(timesteps: int, seed: int, out: str | os.PathLike, n_envs: int | None 
     return path
 
 
+def train_seeds(seeds: list[int], out: str | os.PathLike, use_ray: bool = False,
+                address: str | None = None, ray_cpus: float = 1.0, **kwargs) -> list[Path]:
+    """Train one run per seed into ``out/seed<seed>`` (:func:`train` with ``kwargs``); returns
+    the model paths.  ``use_ray``: each seed is one Ray task (``ray.init()`` on this machine,
+    or joining the cluster at ``address``) reserving ``ray_cpus`` CPUs; the task trains in a
+    temporary directory of its node and returns the run's files, which are written here, so
+    the nodes need no shared file system.  The folders are the same as without Ray."""
+    out = Path(out)
+    dirs = [out / f"seed{s}" for s in seeds]
+    if not use_ray:
+        return [train(seed=s, out=d, **kwargs) for s, d in zip(seeds, dirs)]
+    import ray
+
+    from sim_core.result import atomic_write_bytes
+    started = not ray.is_initialized()
+    if started:
+        if address:
+            ray.init(address=address)
+        else:
+            ray.init(include_dashboard=False)
+    try:
+        task = ray.remote(num_cpus=ray_cpus)(_train_packed)
+        kwargs = dict(kwargs, progress=False)     # a progress bar per task garbles the log
+        refs = [task.remote(s, kwargs) for s in seeds]
+        paths = []
+        for d, files in zip(dirs, ray.get(refs)):
+            for rel, data in files.items():
+                (d / rel).parent.mkdir(parents=True, exist_ok=True)
+                atomic_write_bytes(d / rel, data)
+            paths.append(d / "model.zip")
+        return paths
+    finally:
+        if started:
+            ray.shutdown()
+
+
+def _train_packed(seed: int, kwargs: dict) -> dict[str, bytes]:
+    """Ray task body: :func:`train` in a temporary directory; returns {relative path: bytes}."""
+    import tempfile
+    with tempfile.TemporaryDirectory() as tmp:
+        run = Path(tmp) / "run"
+        train(seed=seed, out=run, **kwargs)
+        return {str(p.relative_to(run)): p.read_bytes() for p in run.rglob("*") if p.is_file()}
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m agents.train_ppo",
                                  description="Train the PPO extraction baseline (see module doc).")
@@ -251,7 +391,23 @@ def main(argv=None) -> int:
                     help="environment steps (default 300000: 9 min per run with three runs "
                          "sharing 2 cores)")
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--out", default="agents/runs/seed0", help="output directory")
+    ap.add_argument("--seeds", type=int, nargs="+", default=None, metavar="SEED",
+                    help="train one run per seed into OUT/seed<SEED> and write the report "
+                         "(agents.report: learning_curve.png, comparison.md) into OUT")
+    ap.add_argument("--out", default=None,
+                    help="output directory (default agents/runs/seed<SEED>; with --seeds the "
+                         "parent directory, default agents/runs)")
+    ap.add_argument("--ray", action="store_true",
+                    help="with --seeds: one Ray task per seed (local ray.init() unless "
+                         "--address); SB3 still trains, Ray only schedules")
+    ap.add_argument("--address", default=None,
+                    help="with --ray: address of a running Ray cluster to join (e.g. auto or "
+                         "HOST:6379); its nodes need this package installed")
+    ap.add_argument("--ray-cpus", type=float, default=1.0,
+                    help="with --ray: CPUs Ray reserves per seed's task (default 1)")
+    ap.add_argument("--hyperparams", default=str(HYPERPARAMS_FILE),
+                    help="RL Zoo yml file with the PPO hyper-parameters (entry "
+                         f"{ENV_ID}; default the shipped agents/hyperparams/ppo.yml)")
     ap.add_argument("--n-envs", type=int, default=None, help="parallel envs (default: cores)")
     ap.add_argument("--vec", choices=("subproc", "dummy"), default="subproc")
     ap.add_argument("--tensorboard", default=None, help="TensorBoard log directory (optional)")
@@ -308,16 +464,37 @@ def main(argv=None) -> int:
     env_kwargs = literal_pairs(args.env_set, "--env-set") if args.env_set else None
     if args.residual == "none":
         args.residual = None
-    path = train(args.timesteps, args.seed, args.out, args.n_envs, args.vec, args.tensorboard,
-                 args.checkpoint_every, not args.no_progress, hyper_overrides=over,
-                 policy_overrides=pol, du_max=args.du_max, env_kwargs=env_kwargs,
-                 random_start=(args.random_start if args.random_start is not None
-                               else 0.0 if args.residual else 0.5),
-                 action_repeat=args.action_repeat, residual=args.residual,
-                 residual_scale=args.residual_scale, residual_omega=args.residual_omega,
-                 residual_w_track=args.residual_track_weight,
-                 obs_offset=(args.obs_offset if args.obs_offset is not None
-                             else 0.005 if args.residual else 0.0))
+    if args.address and not args.ray:
+        ap.error("--address needs --ray")
+    if args.ray and args.seeds is None:
+        ap.error("--ray needs --seeds")
+    if args.ray_cpus <= 0:
+        ap.error(f"--ray-cpus = {args.ray_cpus}: allowed > 0")
+    if not Path(args.hyperparams).is_file():
+        ap.error(f"--hyperparams {args.hyperparams}: file not found")
+    kwargs = dict(timesteps=args.timesteps, n_envs=args.n_envs, vec=args.vec,
+                  tensorboard=args.tensorboard, checkpoint_every=args.checkpoint_every,
+                  progress=not args.no_progress, hyper_overrides=over, policy_overrides=pol,
+                  du_max=args.du_max, env_kwargs=env_kwargs,
+                  random_start=(args.random_start if args.random_start is not None
+                                else 0.0 if args.residual else 0.5),
+                  action_repeat=args.action_repeat, residual=args.residual,
+                  residual_scale=args.residual_scale, residual_omega=args.residual_omega,
+                  residual_w_track=args.residual_track_weight,
+                  obs_offset=(args.obs_offset if args.obs_offset is not None
+                              else 0.005 if args.residual else 0.0),
+                  hyperparams=load_hyperparams(args.hyperparams))
+    if args.seeds is not None:
+        if len(set(args.seeds)) != len(args.seeds):
+            ap.error(f"--seeds {args.seeds}: each seed once")
+        out = Path(args.out or "agents/runs")
+        for path in train_seeds(args.seeds, out, use_ray=args.ray, address=args.address,
+                                ray_cpus=args.ray_cpus, **kwargs):
+            print(f"saved {path}")
+        from . import report
+        report.main(["--runs", *(str(out / f"seed{s}") for s in args.seeds), "--out", str(out)])
+        return 0
+    path = train(seed=args.seed, out=args.out or f"agents/runs/seed{args.seed}", **kwargs)
     print(f"saved {path}")
     return 0
 

@@ -1,7 +1,8 @@
 """boom_env: Gymnasium environments on top of sim_core (telescopic extraction/retraction).
 
     import gymnasium as gym
-    import boom_env  # noqa: F401  (registers the environments)
+    env = gym.make("boom_env:boom_env/TelescopicExtraction-v0")   # imports boom_env, which registers the ids
+    import boom_env  # noqa: F401  (or import it first and use the plain ids)
     env = gym.make("boom_env/TelescopicExtraction-v0")            # fidelity="rl" (modal ROM)
     env = gym.make("boom_env/TelescopicRetraction-v0", fidelity="paper")   # full model, slow
 

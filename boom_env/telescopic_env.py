@@ -9,14 +9,14 @@ Dynamics (``fidelity``)
 -----------------------
 * ``"rl"`` (default): the stroke-parametric modal reduced-order model
   ``sim_core.modal_telescopic`` (in-plane modes of the full sim_core model, linearised about the
-  static equilibrium at each L_s; tables shipped in sim_core/data).  1000-3000 env steps/s
-  on one loaded core, 50-150 times real time (benchmarks/env_speed.md).
+  static equilibrium at each L_s; tables shipped in sim_core/data).  ~2e4 env steps/s on one
+  core, ~900 times real time (benchmarks/env_speed.md).
 * ``"paper"``: the full sim_core model (``sim_core.telescopic``, frictionless by default,
   ``paper_n_nodes`` nodes per spline element, default 3) advanced step by step: for each control
   step the telescopic-cylinder constraint target is replaced by the env's stroke kinematics and
   the model is integrated with ``sim_core.simulate.integrate`` (rtol 1e-6, atol 1e-7) from
-  the current state.  Slow: a real-time factor of order 0.1 or less; for checking policies, not
-  for training.
+  the current state.  Slow: a real-time factor of order 1 or less (benchmarks/env_speed.md);
+  for checking policies, not for training.
 
 Stroke kinematics (both fidelities)
 -----------------------------------
@@ -35,7 +35,7 @@ a_max = 0.25 m/s^2 by default (the paper's cubic schedule, SCENARIOS A4, peaks a
 
 Observation space
 -----------------
-``Box(low, high, (9,), float32)``, SI units:
+``Box(low, high, (9,), float32)``, SI units (``(11,)`` with ``observe_parameters=True``):
 
 ====  ===============================================  ==================
  idx  quantity                                          bounds
@@ -49,6 +49,8 @@ Observation space
   6   tip deflection dZ (m)                             [-1, 1]
   7   rate of dX (m/s)                                  [-10, 10]
   8   rate of dZ (m/s)                                  [-10, 10]
+  9   payload, normalised (only observe_parameters)     [-1, 1]
+ 10   luffing angle, normalised (observe_parameters)    [-1, 1]
 ====  ===============================================  ==================
 
 The deflection is the tip position (boom 3, s = 10 m) minus the static-equilibrium tip of the
@@ -58,21 +60,39 @@ own equilibrium tip at reset moved by the tables' static tip change (the tables 
 across the retraction rope's slack/taut switch near L_s = 2 m, ~1 mm off there).  Deflections are mm-scale: normalise observations
 (e.g. VecNormalize) for learning.  A deflection outside its bounds counts as divergence.
 
+``observe_parameters=True`` appends the episode's payload and luffing angle, mapped linearly
+from the modal tables' range (``sim_core.modal_telescopic.allowed_ranges``: 20-30 t, 45-75 deg)
+to [-1, 1] (x_n = (2 x - lo - hi) / (hi - lo); 25 t and 60 deg give 0).  With
+``payload_range`` / ``angle_range`` the plant changes from episode to episode (first bending
+frequency, quasi-static deflection); without these two entries a policy cannot tell which plant
+it drives.  Default False: the 9-entry observation of the registered ids.
+
 Reward (per step; all weights are constructor arguments)
 --------------------------------------------------------
-    r = - w_time * dt                                        (slowness)
+    r = reward_scale * (
+        - w_time * dt                                        (slowness)
         - w_progress * |L_s - L*| / travel * dt              (distance to go)
         - w_deflection * (|d| / d_ref)^2 * dt                (tip deflection, d_ref = 1e-3 m)
         - w_rate * (|d'| / dv_ref)^2 * dt                     (tip vibration rate, dv_ref = 1e-2 m/s)
         - w_effort * (a / a_max)^2 * dt                       (actuator effort)
         - w_jerk * ((a - a_prev) / a_max)^2                   (jerk, per step)
         - w_end_stop * [end stop hit this step]
-        + bonus                                               (on success, see termination)
+        + bonus)                                              (on success, see termination)
 Defaults: w_time = 1, w_progress = 10, w_deflection = 1, w_rate = 1, w_effort = 0.1,
-w_jerk = 0.1, w_end_stop = 10, bonus = 50.  The progress weight makes standing still (-11 per
-second) clearly worse than extracting: with w_progress = 1 a PPO agent learned to stay at the
-start (return ~ -60 over 30 s) because the paper's cubic schedule, which pays ~3 mm of tip
-deflection while decelerating, scores ~ -76 (agents/README notes).
+w_jerk = 0.1, w_end_stop = 10, bonus = 50, reward_scale = 0.01.  The progress weight makes
+standing still (-11 per second unscaled) clearly worse than extracting: with w_progress = 1 a
+PPO agent learned to stay at the start (return ~ -60 over 30 s) because the paper's cubic
+schedule, which pays ~3 mm of tip deflection while decelerating, scores ~ -76 (agents/README
+notes).
+
+``reward_scale`` multiplies every term and leaves their ratios, and so the ranking of any two
+policies, unchanged.  Unscaled (``reward_scale=1``) a 30 s episode of uniform random actions
+scores -5e3 to -3e4 (the quadratic vibration terms of a white-noise jerk), standing still
+-330, the paper's cubic schedule -147.6; a learner with default settings (no reward
+normalisation) fitted its value function to returns of that size (value loss ~2e6) and learned
+nothing useful.  The default 0.01 brings these to -50...-300, -3.3 and -1.476, the range
+default hyper-parameters are made for.  ``info["reward_unscaled"]`` carries the step's reward
+before scaling.
 
 Start state
 -----------
@@ -99,6 +119,28 @@ Rendering
 ``render_mode="rgb_array"``: side view (X-Z plane) of the three booms with the tip deflection
 exaggerated (``render_exaggeration``, default 500x), numpy uint8 frames (H, W, 3), drawn with
 matplotlib's Agg backend.  ``"human"`` shows the same frames in a matplotlib window.
+
+Use
+---
+    import gymnasium as gym
+    env = gym.make("boom_env:boom_env/TelescopicExtraction-v0")    # imports boom_env itself
+    env = gym.make("boom_env/TelescopicExtraction-v0")             # after ``import boom_env``
+
+The ``module:id`` form makes Gymnasium import ``boom_env`` (which registers the ids) before
+the lookup, so no separate import is needed.  RL Zoo: ``python -m rl_zoo3.train --algo sac
+--env boom_env/TelescopicExtraction-v0 --gym-packages boom_env --conf-file
+agents/hyperparams/sac.yml`` (PPO and SAC hyper-parameter files in agents/hyperparams; what
+they reach: agents/README.md).
+
+Version history
+---------------
+The registered ids keep ``-v0``; their reward and observation changed as listed (newest last).
+
+* Reward as above with w_progress = 1, no scale factor.
+* w_progress = 10 (standing still scored better than the paper's cubic schedule with 1).
+* reward_scale = 0.01 (all terms scaled, ratios unchanged; returns are 1/100 of the earlier
+  ones: ``reward_scale=1`` gives those back), ``info["reward_unscaled"]``; the
+  ``observe_parameters`` option (default off: the observation is unchanged).
 """
 
 from __future__ import annotations
@@ -130,7 +172,8 @@ class TelescopicBoomEnv(gym.Env):
                  n_modes: int = 3, paper_n_nodes: int = 3, paper_friction: bool = False,
                  w_time: float = 1.0, w_progress: float = 10.0, w_deflection: float = 1.0,
                  w_rate: float = 1.0, w_effort: float = 0.1, w_jerk: float = 0.1,
-                 w_end_stop: float = 10.0, bonus: float = 50.0,
+                 w_end_stop: float = 10.0, bonus: float = 50.0, reward_scale: float = 0.01,
+                 observe_parameters: bool = False,
                  tol_stroke: float = 5e-3, tol_speed: float = 5e-3,
                  tol_deflection: float = 2e-4, tol_deflection_rate: float = 2e-3,
                  render_exaggeration: float = 500.0):
@@ -140,7 +183,8 @@ class TelescopicBoomEnv(gym.Env):
             raise ValueError(f"fidelity = {fidelity!r}: allowed 'rl', 'paper'")
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode = {render_mode!r}: allowed {self.metadata['render_modes']}")
-        for name, v in (("dt", dt), ("a_max", a_max), ("v_max", v_max), ("t_max", t_max)):
+        for name, v in (("dt", dt), ("a_max", a_max), ("v_max", v_max), ("t_max", t_max),
+                        ("reward_scale", reward_scale)):
             if not (math.isfinite(v) and v > 0):
                 raise ValueError(f"{name} = {v!r}: must be finite and > 0")
         self.task, self.fidelity, self.render_mode = task, fidelity, render_mode
@@ -165,6 +209,10 @@ class TelescopicBoomEnv(gym.Env):
                       effort=w_effort, jerk=w_jerk, end_stop=w_end_stop, bonus=bonus)
         self.tol = dict(stroke=tol_stroke, speed=tol_speed, deflection=tol_deflection,
                         rate=tol_deflection_rate)
+        self.reward_scale = float(reward_scale)
+        if observe_parameters not in (True, False):
+            raise ValueError(f"observe_parameters = {observe_parameters!r}: allowed True, False")
+        self.observe_parameters = bool(observe_parameters)
         self.d_ref, self.dv_ref = 1e-3, 1e-2
         self.exaggeration = render_exaggeration
         self.action_space = spaces.Box(-1.0, 1.0, (1,), np.float32)
@@ -172,6 +220,9 @@ class TelescopicBoomEnv(gym.Env):
                        np.float32)
         high = np.array([self.L_max, v_max, a_max, self.L_max, t_max, 1.0, 1.0, 10.0, 10.0],
                         np.float32)
+        if self.observe_parameters:
+            low = np.concatenate([low, np.full(2, -1.0, np.float32)])
+            high = np.concatenate([high, np.full(2, 1.0, np.float32)])
         self.observation_space = spaces.Box(low, high, dtype=np.float32)
         self._fig = None
         self._state = None
@@ -182,6 +233,11 @@ class TelescopicBoomEnv(gym.Env):
         if not (math.isfinite(value) and lo - 1e-9 <= value <= hi + 1e-9):
             raise ValueError(f"{name} = {value!r} outside the modal tables' range [{lo:g}, {hi:g}] "
                              "(sim_core.modal_telescopic.allowed_ranges)")
+
+    def _normalised(self, name, value):
+        """``value`` mapped linearly from the tables' range of ``name`` to [-1, 1]."""
+        lo, hi = self._ranges[name]
+        return (2.0 * value - lo - hi) / (hi - lo)
 
     def _segments(self, L, v, a):
         """Exact stroke kinematics over one step: list of (a_eff s^-2, duration s, dv jump at
@@ -307,6 +363,8 @@ class TelescopicBoomEnv(gym.Env):
                    and dv < self.tol["rate"])
         if settled:
             reward += w["bonus"]
+        reward_unscaled = reward
+        reward *= self.reward_scale
         truncated = diverged or self.t >= self.t_max - 1e-9
         if diverged:
             obs = self._last_obs
@@ -314,15 +372,19 @@ class TelescopicBoomEnv(gym.Env):
             obs = self._obs()
             self._last_obs = obs
         info = self._info(sat, stop)
-        info.update(diverged=diverged, reason=reason, success=settled)
+        info.update(diverged=diverged, reason=reason, success=settled,
+                    reward_unscaled=float(reward_unscaled))
         if self.render_mode == "human":
             self.render()
         return obs, float(reward), bool(settled), bool(truncated), info
 
     def _obs(self):
         a = self._a_applied
-        o = np.array([self.rom.L, self.rom.v, a, self.L_target, max(self.t_max - self.t, 0.0),
-                      *self._defl], dtype=np.float64)
+        o = [self.rom.L, self.rom.v, a, self.L_target, max(self.t_max - self.t, 0.0), *self._defl]
+        if self.observe_parameters:
+            o += [self._normalised("payload", self.payload),
+                  self._normalised("luffing_angle_deg", self.angle)]
+        o = np.array(o, dtype=np.float64)
         return np.clip(o, self.observation_space.low, self.observation_space.high).astype(np.float32)
 
     def _info(self, sat, stop):
