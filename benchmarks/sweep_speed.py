@@ -13,7 +13,10 @@ is skipped):
   (~4 s), the worker processes' imports and the summary figure dominate: this is the
   overhead of a sweep.
 * ``beam6``: 6 cases of ``beam_through_sleeve`` over 1 s simulated (a few seconds of
-  solving each): tip force 250/500/1000 N x E 1.5e11/2.1e11 Pa: compute-bound cases.
+  solving each): tip force 250/500/1000 N x E 1.5e11/2.1e11 Pa.
+* ``paper4``: 4 cases of the paper extraction at 2 sub-elements per spline element over 6 s
+  (statics and several seconds of solving each): payload 20/25 t x contact.moment_model
+  rigid/couple: compute-bound cases.
 
 Per run: wall time of the whole run_sweep call (Ray start and stop, every case, the summary
 files), and the sum of the cases' own wall times (``wall_s`` of the rows: one simulate() call
@@ -51,6 +54,9 @@ SWEEPS = {
               {"point_loads.0.force": ["[0, 0, -250]", "[0, 0, -500]", "[0, 0, -1000]"],
                "beams.0.section.E": ["1.5e11", "2.1e11"]},
               {"solver.t_end": "1.0", "solver.n_output": "21"}),
+    "paper4": ("telescopic_extraction",
+               {"payload.mass": ["20000", "25000"], "contact.moment_model": ["rigid", "couple"]},
+               {"booms.n_nodes": "3", "solver.t_end": "6.0"}),
 }
 
 
@@ -91,10 +97,10 @@ def report(rows: list[dict], note: str) -> str:
               "included).  Speed-up: wall with 1 worker / wall with this many workers (ideal 2 "
               "on 2 cores).  rl12 cases take ~0.1 s each, so its wall time is mostly Ray's "
               "start, the workers' imports and the figure.  beam6 cases are compute-bound, "
-              "but each beam case keeps two threads busy (the calling thread and the "
-              "spinning compiled element worker of sim_core/beam/element_worker.py), so two "
-              "beam cases at a time ask for four threads on two cores: their own wall times "
-              "(sum of case wall) grow with 2 workers.  With other work on the machine (load "
+              "and a beam case may start the element worker thread of "
+              "sim_core/beam/element_worker.py beside its own (its governor stops it when it "
+              "lags behind), so with 2 workers the cases' own wall times (sum of case wall) "
+              "grow a little.  With other work on the machine (load "
               "average above the core count) both workers share the cores with it and the "
               "speed-up is below the idle one.",
               "", "Reproduce: `PYTHONPATH=. python benchmarks/sweep_speed.py --note \"...\"`."]
@@ -106,7 +112,7 @@ def main():
     ap.add_argument("--note", required=True,
                     help="machine state written into the report, e.g. 'idle' or 'shared with "
                          "other jobs'")
-    ap.add_argument("--sweeps", default="rl12,beam6",
+    ap.add_argument("--sweeps", default="rl12,beam6,paper4",
                     help=f"comma-separated subset of {','.join(SWEEPS)}")
     ap.add_argument("--out", default=os.path.join(RESULTS, "sweep_speed.md"))
     args = ap.parse_args()
