@@ -1,6 +1,6 @@
 """Energy audit of a telescopic run: where the energy goes, integrated with the motion.
 
-Issue 3 asks for "change of kinetic + elastic + gravity energy = drive work - friction
+The audit checks "change of kinetic + elastic + gravity energy = drive work - friction
 dissipation, to the solver tolerance".  With the equations of motion of the telescopic model
 (Zhao-Qi-Wang 2024, Eq. 34 virtual power; constraint reactions M z_ddot = F + C^T lambda)
 

@@ -81,19 +81,16 @@ class Model:
     # the saddle-point system by block elimination over the elements' own coordinates
     # (constraints.kkt_factor; _block_of: the coordinates shared by two elements, the extra
     # coordinates and the multipliers form the border) where M_r is block-diagonal in them;
-    # False: the LU of the whole matrix (the reference).  Per element rather than per beam
-    # since 2026-11-24 (fourth session): six Cholesky factors of 46 instead of three of 104 and
-    # a border of 68 instead of 33, 233 -> 186 us per factorisation at 8 sub-elements
+    # False: the LU of the whole matrix (the reference).  Per element rather than per beam:
+    # more, smaller Cholesky factors and a wider border factor faster at 8 sub-elements
+    # (benchmarks/telescopic_rhs_speed.py)
     kkt_blocks: bool = True
     # one step of iterative refinement after each compiled block-elimination solve
-    # (saddle_point_compiled).  Off since 2026-11-24 (eighth session): with W = L^-1 B and
-    # S = D - W^T W the elimination's rounding grows with cond(L) = cond(A)^(1/2), not cond(A)
-    # (up to ~1e7 for the paper scene's element blocks with the filter's mass), and its
-    # residual is at the whole matrix LU's level without the step (paper scene at t = 0, 0.5,
-    # 5, 15, 16 s: 2e-15 .. 2e-14 of |F_r|, as the LU's; z_ddot and lambda within 2e-12 of the
-    # LU's, refined or not); the step doubled the solve (0.050 -> 0.120 ms for the friction
-    # Newton's five columns).  The numpy elimination (no numba; A^-1 B by two solves) always
-    # refines
+    # (saddle_point_compiled).  Off: with W = L^-1 B and S = D - W^T W the elimination's
+    # rounding grows with cond(L) = cond(A)^(1/2), not cond(A) (up to ~1e7 for the paper
+    # scene's element blocks with the filter's mass), and its residual is at the whole matrix
+    # LU's level without the step (tests/telescopic/test_assembly_paths.py), while the step
+    # doubles the solve.  The numpy elimination (no numba; A^-1 B by two solves) always refines
     kkt_refine: bool = False
     # payloads and ropes from one compiled evaluation of their points
     # (point_effects.CompiledPointEffects); False: each effect's local() in Python (the reference)
@@ -648,9 +645,8 @@ class Model:
         if not (self.multiplier_forces or self.kkt_blocks):
             return kkt_accelerations(Mr, Fr, self._times_P(J), c_rhs)
         # the saddle-point system by block elimination (pipelined with the worker where it
-        # runs), with friction or without: the frictionless models took the dense LU of the
-        # whole matrix here until 2026-11-24 (eighth session; ~2.5 ms per right-hand side at 8
-        # sub-elements of case 9.1, the cost growing as n^1.15 with the sub-elements)
+        # runs), with friction or without: the dense LU of the whole matrix grows as n^1.15
+        # with the sub-elements and is the slower path at the paper's discretisation
         if deferred and deferred[0] is not None:
             solve = self._pipelined_factor(Mr, Fr, self._times_P(J), blocks, deferred[0])
         else:

@@ -25,9 +25,8 @@ from .statics import static_equilibrium
 # (unchanged since scipy 1.0); integrate() raises it only around its own BDF steps
 # (_bdf_newton_limit) and restores it after each.  Why: the structured Jacobian costs ~45
 # right-hand sides at the paper's discretisation, while a Newton iteration with the stale one
-# costs one, so a slower but converging iteration is cheaper than a new Jacobian.  Measured
-# on the paper's extraction run (2026-11-24, with MethodSwitch's Jacobian probe): 54 -> 33
-# Jacobians, 41.1 -> 38.4 s; the step sizes are still set by the error test.
+# costs one, so a slower but converging iteration is cheaper than a new Jacobian (fewer
+# Jacobians on the paper's extraction run); the step sizes are still set by the error test.
 BDF_NEWTON_ITERATIONS = 8
 
 

@@ -295,7 +295,7 @@ def initial_equilibrium(ts: TelescopicSystem, t: float = 0.0):
     unstretched length is set to its length there (zero tension, no change of the equilibrium).
     Returns (z, lambda).
 
-    Two-rope statics (our reading, issue 6): when the static extraction-rope tension T0 =
+    Two-rope statics (our reading): when the static extraction-rope tension T0 =
     (m3 + m_p) g sin(theta) (C7) is not clearly in the rope's stiff branch (T0 <= (EA/L0) *
     slack_width, e.g. payload 0 at 0 deg), both tension-only ropes would sit at their kink with
     zero axial stiffness and boom 3's axial position is undetermined (Newton stalled at |r| ~
@@ -325,7 +325,7 @@ def initial_equilibrium(ts: TelescopicSystem, t: float = 0.0):
             f"a limit point at {exc.load_factor_max:.3g} x the full weight.  The luffing "
             f"cylinder's lever about the pivot D1 is {lever:.3f} m at this angle (0.714 m at "
             "60 deg) and the booms' deflection shortens it further; the limit load scales with "
-            "E (README, 'The telescopic boom system')")) from exc
+            "E (docs/model.md, 'Initial state and statics')")) from exc
 
 
 def _initial_equilibrium(ts: TelescopicSystem, t: float):

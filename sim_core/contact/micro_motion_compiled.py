@@ -10,7 +10,7 @@ loop stays as the reference and the fallback without numba;
 ``tests/contact/test_sliding_block_contact.py`` checks that both give the same solution.
 The 5 x 5 Newton systems are solved inline (:func:`_solve5`, Gaussian elimination with partial
 pivoting) and the products A x written as loops: numba's ``np.linalg.solve`` copies and calls
-LAPACK for every system (the four regions' values 47 -> 31 us per evaluation, 2026-11-24).
+LAPACK for every system, which costs more than the solve itself at this size.
 
 Returns (x, status, iterations, max |S R|, delta, f, f', R, z) with z = J^-T A^T f' the load
 sensitivity at the solution (zeros unless converged).  Status codes: 0 converged, 1 singular Newton matrix, 2 line search failed, 3 no convergence in

@@ -130,7 +130,7 @@ def test_rom_matches_full_model_on_a_dynamic_window():
     print("ROM / full: residual vibration RMS bending %.2f, axial %.2f; peak deflection while "
           "accelerating bending %.2f, axial %.2f" % (res["bending"], res["axial"],
                                                      res["bending_acc"], res["axial_acc"]))
-    # Claimed agreement (README "Modal ROM"): the bending (perpendicular) residual vibration and
+    # Claimed agreement (docs/model.md, "Modal reduced-order model"): the bending (perpendicular) residual vibration and
     # acceleration deflection within a factor 2 (ratio 0.5-2); the axial one within a factor 4:
     # the full model's retraction rope is tension-only and goes slack while accelerating, a
     # bilinear axial mode (2.84 Hz here) that the linear ROM (both ropes taut, 3.65 Hz) cannot
