@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .beam.moving_node_beam import Beam, BeamSection
+from .drive_profiles import sleeve_motion
 from .effects import Effect, Elasticity, Gravity, Inertia, PointLoad, StressFilter
 from .model import LinearConstraint, Model, boundary_condition
 
@@ -61,9 +62,11 @@ def build_model(scene: dict) -> tuple[Model, np.ndarray, np.ndarray]:
         direction = bc["direction"] if bc["direction"] is not None else d
         s_fun = None
         if bc["kind"] == "sleeve":
-            v = bc["speed"]
-            s_fun = (lambda t, s0=s_end, v=v: s0 + v * t, lambda t, v=v: v, lambda t: 0.0)
-            Qd0[offsets[ib]:offsets[ib] + b.n_coords] += _axial_flow_velocity(b, end, v, d)
+            motion = sleeve_motion(bc, s_end)
+            s_fun = (lambda t, m=motion: m(t)[0], lambda t, m=motion: m(t)[1],
+                     lambda t, m=motion: m(t)[2])
+            Qd0[offsets[ib]:offsets[ib] + b.n_coords] += _axial_flow_velocity(b, end,
+                                                                             motion(0.0)[1], d)
         cons.append(boundary_condition(offsets, beams, ib, end, bc["kind"], pos, direction, s_fun,
                                        fix_torsion=eff["torsion"]))
         constrained_ends.add((ib, end))

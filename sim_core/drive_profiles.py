@@ -244,3 +244,22 @@ class Eq52Profile(_PiecewiseProfile):
         a = np.select([rise, decay], [6 * v0 * r * (t1 - r) / t1**3, -v0 / t3], default=0.0)
         j = np.where(rise, 6 * v0 * (t1 - 2 * r) / t1**3, 0.0)
         return s, v, a, j
+
+
+def sleeve_motion(bc: dict, s0: float = 0.0):
+    """t -> (s, s_dot, s_ddot) of a sleeve end's material coordinate (m, m/s, m/s^2) from its
+    validated ``[[boundary]]`` entry (sim_core.scene): profile "constant" moves at ``speed``
+    from t = 0, s = s0 + speed t; profile "cubic" follows the telescopic drive's schedule of
+    Zhao-Qi-Wang 2024 Section 9 (:class:`CubicSmoothstepSchedule`, SCENARIOS A4) with peak rate
+    ``speed`` (its sign the direction), ramps of ``t_ramp`` and the hold up to ``t_hold_end``.
+    Either motion is monotone in t, so its extreme over [0, t_end] is at t_end."""
+    v = float(bc["speed"])
+    if bc.get("profile", "constant") == "constant" or v == 0.0:
+        return lambda t: (s0 + v * t, v, 0.0)
+    sched = CubicSmoothstepSchedule(v_max=abs(v), t_ramp=bc["t_ramp"],
+                                    t_hold_end=bc["t_hold_end"], sign=1 if v > 0 else -1, s0=s0)
+
+    def motion(t):
+        smp = sched.sample(float(t))
+        return smp.s, smp.v, smp.a
+    return motion

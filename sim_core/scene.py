@@ -22,9 +22,12 @@ Beam-scene schema (units):
              rotary_bending (bool, default true: rotary inertia rho I_t, rho I_b included)
   [[boundary]] beam, end ("left"/"right"), kind ("clamped", "pinned", "roller", "free",
              "sleeve"), position m, direction, speed m/s (sleeve only: rate of the end's
-             material coordinate); one condition per beam end.  A sleeve end may not run out of
-             material nor collapse its element within t_end: left end s_1 + speed t_end in
-             (0, breakpoints[1]), right end s_n + speed t_end in (breakpoints[-2], length)
+             material coordinate), profile (sleeve only: "constant" = speed from t = 0,
+             "cubic" = the telescopic drive's schedule of Section 9 with peak rate speed,
+             t_ramp s (> 0, default 4) and t_hold_end s (>= t_ramp, default 3 t_ramp)); one
+             condition per beam end.  A sleeve end may not run out of material nor collapse
+             its element within t_end: left end s_1 + travel(t_end) in (0, breakpoints[1]),
+             right end s_n + travel(t_end) in (breakpoints[-2], length)
   [[point_loads]] beam, s m (material coordinate at t = 0), speed m/s (moving load, default 0),
              force N (3-vector, global), start s (load switched on at t >= start); the load
              stays on the beam, s + speed t_end in [0, length], and on its modelled part
@@ -259,7 +262,8 @@ _TOP = {"name", "description", "solver", "effects", "filtering", "gravity", "bea
 _EFFECTS = {"gravity", "torsion", "filtering"}
 _BEAM = {"name", "length", "breakpoints", "n_nodes", "n_gauss", "origin", "direction", "section"}
 _SECTION = {"E", "G", "rho", "A", "I_t", "I_b", "J", "I_p", "rotary_bending"}
-_BOUNDARY = {"beam", "end", "kind", "position", "direction", "speed"}
+_BOUNDARY = {"beam", "end", "kind", "position", "direction", "speed", "profile", "t_ramp",
+             "t_hold_end"}
 _LOAD = {"beam", "s", "speed", "force", "start"}
 
 
@@ -347,13 +351,20 @@ def validate(raw: dict, source: str = "<scene>") -> dict:
                              f"condition (boundary[{taken[(ib, end)]}]); one condition per beam end")
         taken[(ib, end)] = i
         speed = number(bc, "speed", w, 0.0)
-        if kind != "sleeve" and "speed" in bc:
-            raise SceneError(f"{w}.speed = {bc['speed']!r}: only a 'sleeve' end has a speed "
-                             f"(this end is {kind!r}); remove it or use kind = 'sleeve'")
+        for key in ("speed", "profile", "t_ramp", "t_hold_end"):
+            if kind != "sleeve" and key in bc:
+                raise SceneError(f"{w}.{key} = {bc[key]!r}: only a 'sleeve' end has a {key} "
+                                 f"(this end is {kind!r}); remove it or use kind = 'sleeve'")
+        profile = choice(bc, "profile", w, ("constant", "cubic"), "constant")
+        if profile == "constant" and ("t_ramp" in bc or "t_hold_end" in bc):
+            raise SceneError(f"{w}.profile = 'constant' with t_ramp/t_hold_end: the ramps belong "
+                             "to the cubic profile (set profile = 'cubic' or remove them)")
+        t_ramp = number(bc, "t_ramp", w, 4.0, lo=0.0, lo_open=True)
         item = {"beam": ib, "end": end, "kind": kind,
                 "position": vector(bc, "position", w, []) if "position" in bc else None,
                 "direction": vector(bc, "direction", w, [], nonzero=True) if "direction" in bc else None,
-                "speed": speed}
+                "speed": speed, "profile": profile, "t_ramp": t_ramp,
+                "t_hold_end": number(bc, "t_hold_end", w, 3.0 * t_ramp, lo=t_ramp)}
         sc["boundary"].append(item)
     _check_sleeve_travel(sc, t_end)
 
@@ -378,15 +389,24 @@ def validate(raw: dict, source: str = "<scene>") -> dict:
 def _modelled_ends(sc: dict, ib: int):
     """Material coordinates of the first and last breakpoint of beam ``ib`` as functions of t:
     a sleeve end moves at its speed, every other end is a material point."""
+    from .drive_profiles import sleeve_motion
     bps = sc["beams"][ib]["breakpoints"]
-    v = {bc["end"]: bc["speed"] for bc in sc["boundary"] if bc["beam"] == ib and bc["kind"] == "sleeve"}
-    return (lambda t: bps[0] + v.get("left", 0.0) * t), (lambda t: bps[-1] + v.get("right", 0.0) * t)
+    m = {bc["end"]: bc for bc in sc["boundary"] if bc["beam"] == ib and bc["kind"] == "sleeve"}
+    fixed = {"speed": 0.0}
+    left = sleeve_motion(m.get("left", fixed), bps[0])
+    right = sleeve_motion(m.get("right", fixed), bps[-1])
+    return (lambda t: left(t)[0]), (lambda t: right(t)[0])
 
 
 def _check_sleeve_travel(sc: dict, t_end: float) -> None:
-    """A sleeve end s(t) = s0 + speed t must stay strictly inside the material (0, length) and
-    before the next breakpoint (the element must not collapse) up to t_end.  The motion is
-    linear, so checking t_end suffices."""
+    """A sleeve end s(t) (drive_profiles.sleeve_motion: s0 + speed t, or the cubic schedule)
+    must stay strictly inside the material (0, length) and before the next breakpoint (the
+    element must not collapse) up to t_end.  The motion is monotone, so checking t_end
+    suffices; its travel is proportional to ``speed``, which gives the allowed speeds."""
+    from .drive_profiles import sleeve_motion
+
+    def travel(bc, speed=None):
+        return sleeve_motion(bc if speed is None else {**bc, "speed": speed})(t_end)[0]
     for i, bc in enumerate(sc["boundary"]):
         if bc["kind"] != "sleeve":
             continue
@@ -397,17 +417,18 @@ def _check_sleeve_travel(sc: dict, t_end: float) -> None:
         single = len(bps) == 2 and other          # one element between two sleeves
         if bc["end"] == "left":
             s0, lo = bps[0], 0.0
-            hi = bps[1] + (other[0]["speed"] * t_end if single else 0.0)
+            hi = bps[1] + (travel(other[0]) if single else 0.0)
             what = ("left sleeve end must stay after the beam's start s = 0 and before the next "
                     "element end")
         else:
             s0, hi = bps[-1], L
-            lo = bps[-2] + (other[0]["speed"] * t_end if single else 0.0)
+            lo = bps[-2] + (travel(other[0]) if single else 0.0)
             what = (f"right sleeve end must stay after the previous element end and before the "
                     f"beam's end s = {L:g}")
-        s_end = s0 + bc["speed"] * t_end
+        s_end = s0 + travel(bc)
         if not lo < s_end < hi:
-            vlo, vhi = (lo - s0) / t_end, (hi - s0) / t_end
+            unit = travel(bc, 1.0)                  # travel by t_end per m/s of speed
+            vlo, vhi = (lo - s0) / unit, (hi - s0) / unit
             raise SceneError(f"boundary[{i}].speed = {bc['speed']!r}: the sleeve end would move from "
                              f"s = {s0:g} to s = {s_end:g} by t_end = {t_end:g} s, outside "
                              f"({lo:g}, {hi:g}) (the {what}); allowed ({vlo:g}, {vhi:g}) m/s")

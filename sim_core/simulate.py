@@ -14,6 +14,7 @@ import scipy.linalg as sla
 from scipy.integrate import BDF, RK45
 
 from .assemble import build_model
+from .drive_profiles import sleeve_motion
 from .errors import ElementEvaluationError, SimulationError, StalledIntegration, SuspectResult
 from .model import Model
 from .result import Result
@@ -811,9 +812,10 @@ def beam_energy_check(model, scene: dict, res: Result) -> dict:
         # modelled part's boundary (the strain and gravity densities are in lambda . b')
         bps = scene["beams"][bc["beam"]]["breakpoints"]
         s0, sign = (bps[0], -1.0) if bc["end"] == "left" else (bps[-1], 1.0)
+        motion = sleeve_motion(bc, s0)
         for k, (t, y) in enumerate(zip(ts, Y)):
-            s_b = s0 + bc["speed"] * t
-            P[k] += sign * bc["speed"] * _kinetic_density(model, bc["beam"], s_b, t, y)
+            s_b, rate, _ = motion(t)
+            P[k] += sign * rate * _kinetic_density(model, bc["beam"], s_b, t, y)
         if "material flow" not in fed:
             fed.append("material flow")
     for pl_scene, pl in zip(scene.get("point_loads", []), model.point_loads):
