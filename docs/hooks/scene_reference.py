@@ -88,16 +88,21 @@ class _Walker(ast.NodeVisitor):
         if isinstance(node, ast.Name) and self.env.get(node.id, ("",))[0] == "path":
             return self.env[node.id][1]
         if isinstance(node, ast.JoinedStr):
-            parts = []
-            for v in node.values:
-                if isinstance(v, ast.Constant):
-                    parts.append(str(v.value))
-                elif isinstance(v.value, ast.Name) and self.env.get(v.value.id, ("",))[0] == "path":
-                    parts.append(self.env[v.value.id][1])
-                else:
-                    parts.append("{}")
-            return "".join(parts)
+            return self.joined(node, lambda path: path, "{}")
         return None
+
+    def joined(self, node: ast.JoinedStr, show_path, other: str) -> str:
+        """An f-string's text: its constant parts, table paths held by local names through
+        ``show_path``, and ``other`` for any other placeholder."""
+        parts = []
+        for v in node.values:
+            if isinstance(v, ast.Constant):
+                parts.append(str(v.value))
+            elif isinstance(v.value, ast.Name) and self.env.get(v.value.id, ("",))[0] == "path":
+                parts.append(show_path(self.env[v.value.id][1]))
+            else:
+                parts.append(other)
+        return "".join(parts)
 
     def keys_of(self, node) -> list[str]:
         if isinstance(node, ast.Constant) and isinstance(node.value, str):
@@ -245,15 +250,7 @@ class _Walker(ast.NodeVisitor):
         if isinstance(node, ast.BinOp) and isinstance(node.op, ast.Add):
             return self.message(node.left) + self.message(node.right)
         if isinstance(node, ast.JoinedStr):
-            parts = []
-            for v in node.values:
-                if isinstance(v, ast.Constant):
-                    parts.append(str(v.value))
-                elif isinstance(v.value, ast.Name) and self.env.get(v.value.id, ("",))[0] == "path":
-                    parts.append(_display_path(self.env[v.value.id][1]))
-                else:
-                    parts.append("…")
-            return "".join(parts)
+            return self.joined(node, _display_path, "…")
         return ""
 
     def record(self, helper, where, key, node):
