@@ -20,8 +20,8 @@ Where the normal load N comes from is the scene's ``contact.friction_load``:
 * ``"resultant"``: N = |(f_t, f_b)|, the transverse resultant of the contact force, which global
   equilibrium fixes whatever the slider's width and pressure distribution.  It is the reading of
   Section 9.2 (4), where the axial component of the constraint force follows its vertical
-  component by "the Coulomb friction ratio", and the one that reproduces the cylinder forces of
-  Figs. 18 and 27 (docs/validation.md).
+  component by "the Coulomb friction ratio", and the one that keeps the telescopic-cylinder
+  force of Fig. 27 near its static value (docs/validation.md).
 
 How much moment a contact region carries is ``contact.moment_model`` (sim_core.telescopic):
 ``rigid`` (Section 6: the two bending Cardan angles coincide, multipliers), ``seat`` (they are
@@ -173,7 +173,7 @@ class ContactFriction:
             Lf, Lm3 = section_reaction_maps(point, Q, self.basis, 3)
             seat = ts.seats.get(name)
             # the seat's moment does not depend on the multipliers: a constant of the state
-            m0 = None if seat is None else Lm3[:, :2] @ seat.multipliers(Q)
+            m0 = np.zeros(3) if seat is None else Lm3[:, :2] @ seat.multipliers(Q)
             regions.append((name, s_idx, rp, ra, Lf, Lm3[:, kept],
                             self.law.mu(float(Qd[s_idx])), geom, m0))
         return FrictionAtState(self, regions, t, batch=only is None)
@@ -319,9 +319,7 @@ class FrictionAtState:
         x0 = self.owner._x0
         spring = self.owner.spring
         for name, s_idx, rp, ra, Lf, Lm, mu, geom, m0 in self.regions:
-            f_c, m_c = Lf @ lam[rp], Lm @ lam[ra]
-            if m0 is not None:
-                m_c = m_c + m0
+            f_c, m_c = Lf @ lam[rp], Lm @ lam[ra] + m0
             N_res = float(np.hypot(f_c[1], f_c[2]))
             if geom is None:
                 out.append((name, s_idx, mu, N_res))
@@ -364,8 +362,7 @@ class FrictionAtState:
                 continue
             # Eq. 65's normal load by the micro-motion solve (Eqs. 59-71) and its sensitivity
             # d N / d(f_t, f_b, m_s, m_t, m_b) (ContactSolution.normal_load_gradient)
-            m_c = Lm @ lam[ra] if m0 is None else Lm @ lam[ra] + m0
-            N, dN, x0[name] = normal_load(geom, spring, f_c, m_c, mu, *mats,
+            N, dN, x0[name] = normal_load(geom, spring, f_c, Lm @ lam[ra] + m0, mu, *mats,
                                           x0=x0.get(name), t=self.t)
             g[r] = -mu * N
             if gradient and mu != 0.0:
