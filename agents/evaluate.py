@@ -50,11 +50,12 @@ from typing import Callable
 
 import numpy as np
 
+from .settings import ENV_ID
+
 STROKE_TOL = 0.01        # m, "reaches the target" (issue: within 1 cm)
 SPEED_TOL = 5e-3         # m/s, the env's tol_speed
 RESIDUAL_WINDOW = 4.0    # s
 FIXED_WINDOW = (16.0, 20.0)   # s, after the end of the paper's cubic schedule
-ENV_ID = "boom_env/TelescopicExtraction-v0"
 
 
 @dataclass
@@ -86,11 +87,11 @@ def telescopic_force(env, a: float) -> float:
 
     F = m2 (a + g sin th) + 2 T_e with T_e = (m3 + m_p)(2 a + g sin th): the rigid-boom force of
     the inextensible rope drive (boom 3 moves twice the stroke, Zhao-Qi-Wang 2024 Eqs. 74-76;
-    ``sim_core.rigid_telescopic``), plus the elastic part Gamma . q'' of the modal coordinates:
+    ``sim_core.systems.telescopic.rigid``), plus the elastic part Gamma . q'' of the modal coordinates:
     the kinetic energy of Q = Q_s(L_s) + Phi q has the cross term L_s' Gamma . q' (Gamma = Phi^T M
     dQ_s/dL_s, mass-normalised modes), whose Lagrange term along L_s is Gamma . q''.  The ROM is
     frictionless and drops the slow d Gamma/dt terms."""
-    from sim_core.telescopic import TelescopicParams, boom_section
+    from sim_core.systems.telescopic.params import TelescopicParams, boom_section
     u = env.unwrapped
     if not hasattr(u, "_masses"):
         p = TelescopicParams()
@@ -327,7 +328,7 @@ def plot(traces: dict, path: str | os.PathLike, title: str | None = None) -> Non
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from sim_core.plots import save_figure
+    from sim_core.figures import save_figure
     fig, ax = plt.subplots(3, 1, figsize=(7.5, 7.5), sharex=True)
     for name, tr in traces.items():
         ax[0].plot(tr.t, tr.stroke, label=name)

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from sim_core.plots import save_figure
+from sim_core.figures import save_figure
 
 from .evaluate import atomic_write_text
 
@@ -43,7 +43,7 @@ def read_curve(run: Path) -> np.ndarray:
 
 def cubic_training_return(env_kwargs: dict | None = None) -> float:
     """Return of the paper's cubic schedule from 2 m in the *training* env (the registered env
-    with the run's env arguments, default agents.train_ppo.TRAIN_ENV_KWARGS; reward scale 1
+    with the run's env arguments, default agents.settings.TRAIN_ENV_KWARGS; reward scale 1
     unless they set it, as agents.train_ppo.train trains).  Runs with random
     start strokes (agents.wrappers.RandomStart) are not strictly comparable with it; for a
     residual run it is the return of the residual policy's u = 0."""
@@ -53,7 +53,7 @@ def cubic_training_return(env_kwargs: dict | None = None) -> float:
 
     from .evaluate import ENV_ID, run_episode, scripted_policy
     from .schedules import cubic
-    from .train_ppo import TRAIN_ENV_KWARGS
+    from .settings import TRAIN_ENV_KWARGS
     env = gym.make(ENV_ID, **{"reward_scale": 1.0,
                               **(TRAIN_ENV_KWARGS if env_kwargs is None else env_kwargs)})
     u = env.unwrapped

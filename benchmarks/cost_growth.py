@@ -17,7 +17,7 @@ h = 0.01 s; ``TelescopicParams(n_booms=N, n_nodes=n_sub + 1)``):
   best of 3 runs: steps, RHS evaluations, and ``wall_per_sim_s`` = wall time / T.
 
 Wall time (``time.perf_counter``), not process time, since 2026-11-24 (eighth session): the
-persistent element worker (``sim_core/beam/element_worker.py``) spins for 5 ms after each
+persistent element worker (``sim_core/model/workers.py``) spins for 5 ms after each
 request, and process time counts that idle spinning as work (the eighth session's first run
 with process time: 5.0 ms per RHS at 8 sub-elements against 1.0 ms of wall time, n^1.2).
 With the filter on, RK45 is
@@ -44,9 +44,10 @@ import numpy as np
 
 sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..")))
 
-from sim_core.result import atomic_write_bytes                                # noqa: E402
-from sim_core.simulate import integrate                                       # noqa: E402
-from sim_core.telescopic import TelescopicParams, build_telescopic                 # noqa: E402
+from sim_core.integrate.driver import integrate  # noqa: E402
+from sim_core.result import atomic_write_bytes  # noqa: E402
+from sim_core.systems.telescopic.params import TelescopicParams# noqa: E402
+from sim_core.systems.telescopic.build import build_telescopic
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 FIELDS = ["sweep", "n_booms", "n_sub", "n_dof", "rhs_ms", "t_sim", "n_steps", "n_rhs", "wall_s",

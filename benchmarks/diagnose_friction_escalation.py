@@ -22,9 +22,9 @@ import time
 import numpy as np
 from scipy.integrate import RK45
 
-from sim_core.scene import load_scene
-from sim_core.telescopic import build_telescopic, initial_equilibrium
-from sim_core.telescopic_scene import params_from_scene
+from sim_core import load_scene
+from sim_core.systems.telescopic.build import build_telescopic, initial_equilibrium
+from sim_core.systems.telescopic.schema import params_from_scene
 
 
 def _value(v: str):

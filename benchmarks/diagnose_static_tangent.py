@@ -11,11 +11,16 @@ iterations, and there the same check gives |cen - K d| = 0.2 % of |K d|.  At n_n
 difference along d (e = 1e-5) differs from K d by 200 % while forward and backward differences
 agree to 1 %: the mismatch sits in the moves of booms 2 and 3 (whose junction s_3 is a
 coordinate), not boom 1 (junction fixed at L_h).  Kept to reproduce the problem; the statics
-use central differences because of it (sim_core.statics._force_tangent, CHANGELOG.md).
+use central differences because of it (sim_core.model.statics.force_tangent, CHANGELOG.md).
 """
-import numpy as np, sys
-from sim_core.telescopic import TelescopicParams, build_telescopic
-from sim_core.constraints import constraint_terms
+import sys
+
+import numpy as np
+
+from sim_core.physics.constraints import constraint_terms
+from sim_core.systems.telescopic.params import TelescopicParams
+from sim_core.systems.telescopic.build import build_telescopic
+
 p = TelescopicParams(n_nodes=int(sys.argv[1]), friction=False, E=2.1e12, payload=1000.0)
 ts = build_telescopic(p); m = ts.model
 for r in m.point_effects:

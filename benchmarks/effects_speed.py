@@ -31,11 +31,10 @@ from datetime import datetime, timezone
 
 sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..")))
 
-from sim_core import load_scene                               # noqa: E402
-from sim_core.errors import SimulationError                   # noqa: E402
-from sim_core.telescopic import (build_telescopic, initial_equilibrium,   # noqa: E402
-                                 simulate_telescopic)
-from sim_core.telescopic_scene import params_from_scene       # noqa: E402
+from sim_core import load_scene  # noqa: E402
+from sim_core.errors import SimulationError  # noqa: E402
+from sim_core.systems.telescopic.build import build_telescopic, initial_equilibrium, simulate_telescopic# noqa: E402
+from sim_core.systems.telescopic.schema import params_from_scene  # noqa: E402
 
 ROWS = [
     ("full scene (paper 9.2)", {}),

@@ -22,10 +22,10 @@ from pathlib import Path
 
 import numpy as np
 
-from sim_core.folding import FoldingParams, simulate_folding
-from sim_core.folding_plots import plot_folding
-from sim_core.plots import save_figure
+from sim_core.figures import save_figure
 from sim_core.result import atomic_write_bytes
+from sim_core.systems.folding.build import FoldingParams, simulate_folding
+from sim_core.systems.folding.plots import plot_folding
 
 OUT = Path(__file__).parent / "results" / "folding_filter_h"
 

@@ -7,7 +7,7 @@ One command (from the repository root):
 For the paper's extraction scene (25 t, friction with the slider-spring distribution, filter,
 elastic ropes) at 1, 2, 4 and 8 sub-elements per spline element (booms.n_nodes 2+1 ... 8+1), at
 the static equilibrium with a small random velocity and the contact points sliding, it times:
-one right-hand side, the structured Jacobian of :mod:`sim_core.state_jacobian` (forward
+one right-hand side, the structured Jacobian of :mod:`sim_core.model.state_jacobian` (forward
 differences, as BDF uses it) and the whole-rhs forward-difference Jacobian scipy's BDF forms
 (2 n_dof right-hand sides; timed, not extrapolated), and checks that the two Jacobians agree
 (relative Frobenius difference of the acceleration rows).  Each time is the best of three
@@ -30,11 +30,11 @@ import numpy as np
 
 sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..")))
 
-from sim_core import load_scene                               # noqa: E402
-from sim_core.result import atomic_write_bytes                # noqa: E402
-from sim_core.state_jacobian import state_jacobian            # noqa: E402
-from sim_core.telescopic import build_telescopic, initial_equilibrium   # noqa: E402
-from sim_core.telescopic_scene import params_from_scene       # noqa: E402
+from sim_core import load_scene  # noqa: E402
+from sim_core.model.state_jacobian import state_jacobian  # noqa: E402
+from sim_core.result import atomic_write_bytes  # noqa: E402
+from sim_core.systems.telescopic.build import build_telescopic, initial_equilibrium# noqa: E402
+from sim_core.systems.telescopic.schema import params_from_scene  # noqa: E402
 
 OUT = os.path.join(os.path.dirname(__file__), "results")
 

@@ -18,7 +18,7 @@ as a child process (``python -m sim_core.cli``, so the checkout's package is the
   two threads (the element worker), about the wall where it runs one;
 * ``sim wall``: the integration's own wall time (summary.json ``wall_time_s``), and the
   summary's step count and the element worker's state at the end (``worker_in_use``,
-  ``worker_stops``: sim_core.beam.element_worker.Governor).
+  ``worker_stops``: sim_core.model.workers.Governor).
 
 Cases:
 
@@ -55,8 +55,8 @@ import time
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
 sys.path.insert(0, ROOT)
 
-from sim_core.result import atomic_write_bytes                                # noqa: E402
-from sim_core.scene import load_scene                                         # noqa: E402
+from sim_core import load_scene  # noqa: E402
+from sim_core.result import atomic_write_bytes  # noqa: E402
 
 RESULTS = os.path.join(ROOT, "benchmarks", "results")
 SCENE = "telescopic_extraction"

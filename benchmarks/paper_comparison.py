@@ -45,7 +45,7 @@ LOADS = ("resultant", "springs")
 DEFAULT = ("rigid", "resultant")
 THETA = math.radians(60.0)
 MU_D = 0.1
-# slider springs per region, in sim_core.contact order: arc by arc (P1, P2, P3), within an arc
+# slider springs per region, in sim_core.physics.contact order: arc by arc (P1, P2, P3), within an arc
 # the front end (k_s = +1, towards the payload: the paper's rounding I-x) then the back end
 # (k_s = -1, towards the platform: II-x), 20 springs per quarter arc and end
 NQ = 20

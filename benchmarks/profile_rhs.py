@@ -44,11 +44,13 @@ if "--root" in sys.argv:
     _ROOT = os.path.abspath(sys.argv[sys.argv.index("--root") + 1])
 sys.path.insert(0, _ROOT)
 
-from sim_core import load_scene                                    # noqa: E402
-from sim_core.assemble import build_model, reference_basis         # noqa: E402
-from sim_core.beam.moving_node_beam import Beam, BeamSection       # noqa: E402
-from sim_core.effects import Elasticity, Gravity, Inertia          # noqa: E402
-from sim_core.model import _CSTEP, Model, boundary_condition       # noqa: E402
+from sim_core import load_scene  # noqa: E402
+from sim_core.model.boundary import boundary_condition, reference_basis
+from sim_core.model.model import Model  # noqa: E402
+from sim_core.physics.beam.moving_node_beam import Beam, BeamSection  # noqa: E402
+from sim_core.physics.complex_step import COMPLEX_STEP as _CSTEP  # noqa: E402
+from sim_core.physics.effects import Elasticity, Gravity, Inertia  # noqa: E402
+from sim_core.systems.beam.build import build_model  # noqa: E402
 
 NODES = (5, 9, 17)
 

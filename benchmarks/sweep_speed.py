@@ -98,7 +98,7 @@ def report(rows: list[dict], note: str) -> str:
               "on 2 cores).  rl12 cases take ~0.1 s each, so its wall time is mostly Ray's "
               "start, the workers' imports and the figure.  beam6 cases are compute-bound, "
               "and a beam case may start the element worker thread of "
-              "sim_core/beam/element_worker.py beside its own (its governor stops it when it "
+              "sim_core/model/workers.py beside its own (its governor stops it when it "
               "lags behind), so with 2 workers the cases' own wall times (sum of case wall) "
               "grow a little.  With other work on the machine (load "
               "average above the core count) both workers share the cores with it and the "

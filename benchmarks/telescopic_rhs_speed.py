@@ -19,14 +19,14 @@ last evaluation, and a benchmark that repeats one state measures cache hits.  Va
 * ``+ compiled section``      and the section state (Eqs. 24-33) as a compiled numba loop,
 * ``+ compiled micro-motion`` and the micro-motion Newton (Eqs. 59-71) compiled too,
 * ``+ compiled points``       and the one-point kinematics of the constraint, rope and contact
-  points (``sim_core.beam.point_compiled``),
+  points (``sim_core.physics.beam._moving_node_beam_numba``),
 * ``+ compiled elements``     and the element mass matrices and forces
-  (``sim_core.beam.element_compiled``),
+  (``sim_core.physics._effects_numba``),
 * ``+ block saddle-point solve`` and the saddle-point system by block elimination over the
-  beams (``Model.kkt_blocks``, compiled: ``sim_core.saddle_point_compiled``; before: the LU of
+  beams (``Model.kkt_blocks``, compiled: ``sim_core.model._saddle_point_numba``; before: the LU of
   the whole matrix),
 * ``+ compiled scatter``      and the element and point-effect blocks added into the reduced
-  arrays by the compiled loop of ``sim_core.assembly_compiled`` (before: its numpy version),
+  arrays by the compiled loop of ``sim_core.model._assembly_numba`` (before: its numpy version),
 * ``+ elements on a worker thread`` and the compiled element batch on a second thread while
   the constraint rows are formed (``Model.element_thread``; the rows before run the batch on
   the calling thread),
@@ -38,14 +38,14 @@ last evaluation, and a benchmark that repeats one state measures cache hits.  Va
 * ``+ friction Newton in one compiled call`` and the friction-multiplier Newton's loop
   compiled (``Model.multiplier_newton_compiled``),
 * ``+ constraint rows in one compiled program`` and the constraint rows of all constraints
-  in one compiled call (``constraints.COMPILED_ROWS``, ``sim_core.constraint_compiled``),
+  in one compiled call (``constraints.COMPILED_ROWS``, ``sim_core.physics._constraints_numba``),
 * ``+ friction Newton warm-started`` and the friction-multiplier Newton started from the last
   solution (``Model.multiplier_warm_start``; before: from zero friction),
 * ``+ payload and ropes in one compiled call`` and the payload's and the ropes' blocks from
   one compiled evaluation of their points (``Model.point_effects_compiled``),
 * ``+ persistent compiled worker`` and the element batch handed to a compiled worker loop
   through a mailbox and an atomic state word instead of the thread pool
-  (``Model.element_spin``, ``sim_core.beam.element_worker``: no queue, no thread wake-up, no
+  (``Model.element_spin``, ``sim_core.model.workers``: no queue, no thread wake-up, no
   GIL hand-over),
 * ``+ factor pipelined with the worker`` and each element's saddle-point block added and
   factored as soon as the worker publishes the element (``Model.kkt_pipeline``,
@@ -88,11 +88,15 @@ import numpy as np
 
 sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..")))
 
-from sim_core import assembly_compiled, constraints           # noqa: E402
-from sim_core.beam import cardan_compiled, element_compiled, point_compiled  # noqa: E402
-from sim_core.contact import micro_motion_compiled            # noqa: E402
-from sim_core.result import atomic_write_bytes                # noqa: E402
-from jacobian_speed import sliding_state                      # noqa: E402  (benchmarks/)
+from jacobian_speed import sliding_state  # noqa: E402  (benchmarks/)
+
+from sim_core.model import _assembly_numba as assembly_compiled  # noqa: E402
+from sim_core.physics import _effects_numba as element_compiled
+from sim_core.physics import constraints
+from sim_core.physics.beam import _cardan_numba as cardan_compiled  # noqa: E402
+from sim_core.physics.beam import _moving_node_beam_numba as point_compiled
+from sim_core.physics.contact import _sliding_block_contact_numba as micro_motion_compiled  # noqa: E402
+from sim_core.result import atomic_write_bytes  # noqa: E402
 
 OUT = os.path.join(os.path.dirname(__file__), "results", "telescopic_rhs_speed.md")
 
@@ -120,12 +124,12 @@ VARIANTS = tuple((label,) + (True,) * k + (False,) * (len(_LABELS) - 1 - k)
 # none of them calls another group's functions)
 GROUPS = (
     ("friction (section maps, micro-motion solves, sensitivities)",
-     ("contact_friction.py:at_state", "contact_friction.py:values",
-      "contact_friction.py:newton")),
+     ("friction.py:at_state", "friction.py:values",
+      "friction.py:newton")),
     ("constraint rows (Jacobian, quadratic terms)", ("constraints.py:constraint_terms",)),
-    ("saddle-point factorisation", ("constraints.py:kkt_factor",)),
-    ("saddle-point solves", ("_decomp_lu.py:lu_solve", "constraints.py:once",
-                             "saddle_point_compiled.py:solve")),
+    ("saddle-point factorisation", ("saddle_point.py:kkt_factor",)),
+    ("saddle-point solves", ("_decomp_lu.py:lu_solve", "saddle_point.py:once",
+                             "_saddle_point_numba.py:solve")),
     ("point effects (payload, ropes)", ("point_effects.py:local",)),
     ("elements (kinematics, mass, forces)", ("model.py:element_terms",
                                              "model.py:_element_blocks_started")),

@@ -27,7 +27,7 @@ simulated second).  ``--part beam`` / ``--part telescopic`` runs one part only.
     equilibrium; case 9.1 (nearly rigid, E = 2.1e12 Pa, 1 t payload) and the flexible 25 t case.
     Error = |tip position(T) - reference tip position(T)| (m, Euclidean, boom-3 top centre).
     Reference: the finest mesh of the sweep, smallest filter h of the sweep, RK45 rtol 1e-9.
-    Implicit integrators use :class:`sim_core.integrators.index1.Index1System` (M = I,
+    Implicit integrators use :class:`sim_core.integrate.index1.Index1System` (M = I,
     f = Baumgarte-stabilized KKT accelerations).
 
 Every row records wall time (s), wall seconds per simulated second, steps, model evaluations
@@ -53,15 +53,18 @@ import numpy as np
 
 sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..")))
 
-from sim_core.assemble import reference_basis                          # noqa: E402
-from sim_core.beam.moving_node_beam import Beam, BeamSection           # noqa: E402
-from sim_core.effects import Elasticity, Inertia, PointLoad, StressFilter  # noqa: E402
-from sim_core.errors import SimulationError                            # noqa: E402
-from sim_core.integrators import integrate_generalized_alpha, integrate_scipy  # noqa: E402
-from sim_core.integrators.index1 import Index1System                   # noqa: E402
-from sim_core.model import Model, boundary_condition                   # noqa: E402
-from sim_core.simulate import integrate                           # noqa: E402
-from sim_core.validation.closed_form import fryba_deflection           # noqa: E402
+from sim_core.errors import SimulationError  # noqa: E402
+from sim_core.integrate import integrate_generalized_alpha, integrate_scipy  # noqa: E402
+from sim_core.integrate.driver import integrate  # noqa: E402
+from sim_core.integrate.index1 import Index1System  # noqa: E402
+from sim_core.model.boundary import (
+    boundary_condition,
+    reference_basis,  # noqa: E402
+)
+from sim_core.model.model import Model  # noqa: E402
+from sim_core.physics.beam.moving_node_beam import Beam, BeamSection  # noqa: E402
+from sim_core.physics.effects import Elasticity, Inertia, PointLoad, StressFilter  # noqa: E402
+from sim_core.validation.closed_form import fryba_deflection  # noqa: E402
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 FIELDS = ["case", "integrator", "n_sub", "rtol", "filter_h", "t_sim", "status", "wall_s",
@@ -124,7 +127,7 @@ def run_integrator(integrator, system_for_implicit, rk_model, z0, zd0, t_end, rt
     """-> (q at t_eval (k, n), stats dict).  atol = rtol * 1e-3 (m, rad; m/s, rad/s)."""
     atol = 1e-3 * rtol
     n = z0.size
-    if integrator in ("RK45", "auto"):           # sim_core.simulate.integrate on model.rhs
+    if integrator in ("RK45", "auto"):           # sim_core.integrate.driver.integrate on model.rhs
         b = _Budget(system_for_implicit)
         t, ys, st = integrate(rk_model, np.concatenate([z0, zd0]), t_end,
                               {"rtol": rtol, "atol": atol, "n_output": len(t_eval),
@@ -226,7 +229,8 @@ def telescopic_system(case: str, n_sub: int, filter_h: float):
     """Build the scene and its static equilibrium (cached per case and mesh: the filter does
     not change the statics).  initial_equilibrium also sets the retraction-rope length, so it
     is re-applied to every freshly built system."""
-    from sim_core.telescopic import TelescopicParams, build_telescopic, initial_equilibrium
+    from sim_core.systems.telescopic.params import TelescopicParams
+    from sim_core.systems.telescopic.build import build_telescopic, initial_equilibrium
     kw = dict(E=2.1e12, payload=1000.0) if case == "rigid_9.1" else dict(payload=25000.0)
     p = TelescopicParams(n_nodes=n_sub + 1, filter_h=filter_h, friction=False, **kw)
     ts = build_telescopic(p)

@@ -8,13 +8,13 @@ is to reach the target quickly while leaving as little tip vibration as possible
 Dynamics (``fidelity``)
 -----------------------
 * ``"rl"`` (default): the stroke-parametric modal reduced-order model
-  ``sim_core.modal_telescopic`` (in-plane modes of the full sim_core model, linearised about the
+  ``sim_core.systems.telescopic.modal`` (in-plane modes of the full sim_core model, linearised about the
   static equilibrium at each L_s; tables shipped in sim_core/data).  ~2e4 env steps/s on one
   core, ~900 times real time (benchmarks/env_speed.md).
-* ``"paper"``: the full sim_core model (``sim_core.telescopic``, frictionless by default,
+* ``"paper"``: the full sim_core model (``sim_core.systems.telescopic.build``, frictionless by default,
   ``paper_n_nodes`` nodes per spline element, default 3) advanced step by step: for each control
   step the telescopic-cylinder constraint target is replaced by the env's stroke kinematics and
-  the model is integrated with ``sim_core.simulate.integrate`` (rtol 1e-6, atol 1e-7) from
+  the model is integrated with ``sim_core.integrate.driver.integrate`` (rtol 1e-6, atol 1e-7) from
   the current state.  Slow: a real-time factor of order 1 or less (benchmarks/env_speed.md);
   for checking policies, not for training.
 
@@ -61,7 +61,7 @@ across the retraction rope's slack/taut switch near L_s = 2 m, ~1 mm off there).
 (e.g. VecNormalize) for learning.  A deflection outside its bounds counts as divergence.
 
 ``observe_parameters=True`` appends the episode's payload and luffing angle, mapped linearly
-from the modal tables' range (``sim_core.modal_telescopic.allowed_ranges``: 20-30 t, 45-75 deg)
+from the modal tables' range (``sim_core.systems.telescopic.modal.allowed_ranges``: 20-30 t, 45-75 deg)
 to [-1, 1] (x_n = (2 x - lo - hi) / (hi - lo); 25 t and 60 deg give 0).  With
 ``payload_range`` / ``angle_range`` the plant changes from episode to episode (first bending
 frequency, quasi-static deflection); without these two entries a policy cannot tell which plant
@@ -103,7 +103,7 @@ the paper's strokes), q = 0.  ``reset(seed=..., options=...)``: options may set 
 ``self.np_random`` at every reset (seeded through reset(seed)).  The ROM tables cover
 payload 20-30 t and luffing angles 45-75 deg (tabulated at 45, 60, 75 deg and interpolated
 linearly between them: first bending frequency within 0.7 % of the full model's at 52.5 deg,
-tests/env/test_modal.py; ``sim_core.modal_telescopic.allowed_ranges``); values outside raise
+tests/env/test_modal.py; ``sim_core.systems.telescopic.modal.allowed_ranges``); values outside raise
 ValueError.
 
 Episode end
@@ -152,7 +152,7 @@ import numpy as np
 from gymnasium import spaces
 
 from sim_core.errors import SimulationError
-from sim_core.modal_telescopic import ModalROM, allowed_ranges, tables_for
+from sim_core.systems.telescopic.modal import ModalROM, allowed_ranges, tables_for
 from sim_core.validation.closed_form import luffing_geometry
 
 BOOM_LENGTH = 10.0          # m, SCENARIOS A1
@@ -232,7 +232,7 @@ class TelescopicBoomEnv(gym.Env):
         lo, hi = self._ranges[name]
         if not (math.isfinite(value) and lo - 1e-9 <= value <= hi + 1e-9):
             raise ValueError(f"{name} = {value!r} outside the modal tables' range [{lo:g}, {hi:g}] "
-                             "(sim_core.modal_telescopic.allowed_ranges)")
+                             "(sim_core.systems.telescopic.modal.allowed_ranges)")
 
     def _normalised(self, name, value):
         """``value`` mapped linearly from the tables' range of ``name`` to [-1, 1]."""
@@ -409,7 +409,8 @@ class TelescopicBoomEnv(gym.Env):
     def _paper_reset(self, L0):
         from dataclasses import replace
 
-        from sim_core.telescopic import TelescopicParams, build_telescopic, initial_equilibrium
+        from sim_core.systems.telescopic.params import TelescopicParams
+        from sim_core.systems.telescopic.build import build_telescopic, initial_equilibrium
         p = replace(TelescopicParams(), payload=self.payload, luffing_angle_deg=self.angle,
                     stroke0=L0, n_nodes=self.paper_n_nodes, friction=self.paper_friction)
         self._ts = build_telescopic(p)
@@ -433,7 +434,7 @@ class TelescopicBoomEnv(gym.Env):
         return (L + v * t, v, 0.0)
 
     def _paper_advance(self, segs):
-        from sim_core.simulate import integrate
+        from sim_core.integrate.driver import integrate
         self._kin = (self.rom.L, self.rom.v, segs)
         _, ys, _ = integrate(self._ts.model, self._y, self.dt,
                                   {"rtol": 1e-6, "atol": 1e-7, "n_output": 2})

@@ -4,7 +4,8 @@ Reference: T. Zhao, Z. Qi, T. Wang, "Dynamic Contact Analysis of Flexible Telesc
 Systems with Moving Boundary", Mathematics 12 (2024) 2496 (the "first seed"), and the
 folding long-boom manipulator paper (SIMULTECH 2020, the "second seed").  SI units throughout.
 
-    from sim_core import load_scene, simulate
+    from sim_core import load_scene
+    from sim_core import simulate
     result = simulate(load_scene("beam_through_sleeve"))
     result.t, result["tip_position"]
 """
@@ -17,11 +18,9 @@ import os as _os
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     _os.environ.setdefault(_var, "1")
 
-__version__ = "0.1.0"
-
-from .errors import SceneError, SimulationError  # noqa: E402
-from .result import Result  # noqa: E402
-from .scene import load_scene  # noqa: E402
-from .simulate import simulate  # noqa: E402
+from sim_core._version import __version__  # noqa: E402
+from sim_core.api import load_scene, simulate  # noqa: E402
+from sim_core.errors import SceneError, SimulationError  # noqa: E402
+from sim_core.result import Result  # noqa: E402
 
 __all__ = ["load_scene", "simulate", "Result", "SceneError", "SimulationError", "__version__"]

@@ -16,9 +16,11 @@ import sys
 import time
 from pathlib import Path
 
-from .errors import SceneError, SimulationError
-from .result import Result, atomic_write_bytes
-from .scene import load_scene, shipped_scenes
+from sim_core.api import load_scene, simulate
+from sim_core.errors import SceneError, SimulationError
+from sim_core.registry import system_kind
+from sim_core.result import Result, atomic_write_bytes
+from sim_core.scene.io import shipped_scenes
 
 
 def _overrides(items: list[str] | None) -> dict:
@@ -67,18 +69,7 @@ def _one_line(msg: object) -> str:
     return " ".join(str(msg).split())
 
 
-def _partial_result(exc: SimulationError) -> Result | None:
-    """The outputs up to the failure, if the solver attached them to the error
-    (``exc.result`` or ``exc.partial_result``, a :class:`Result`)."""
-    for name in ("result", "partial_result"):
-        res = getattr(exc, name, None)
-        if isinstance(res, Result):
-            return res
-    return None
-
-
 def cmd_run(args) -> int:
-    from .simulate import simulate
     scene = load_scene(args.scene, _overrides(args.set))
     out = Path(args.out)
     prog = _Progress(scene["solver"]["t_end"], not args.quiet)
@@ -112,7 +103,7 @@ def _save_failure(scene: dict, out: Path, exc: SimulationError) -> str:
     ``error`` set) and a summary.json naming the failure.  Returns a note for the one-line
     message.  Never raises (the SimulationError is what the user must see); a file that cannot
     be written is reported on stderr."""
-    partial = _partial_result(exc)
+    partial = getattr(exc, "result", None)         # the outputs up to the failure, if any
     summary = {"scene": scene["name"], "error": _one_line(exc), "t_fail_s": exc.t,
                "step_s": exc.step, "result_file": None}
     try:
@@ -146,13 +137,8 @@ def _plots(result: Result, out: Path) -> list:
 
 
 def _figures(result: Result, out: Path) -> list:
-    """Every figure that applies to the result (``run`` and ``plot``)."""
-    from .plots import plot_result, plot_telescopic
-    figs = plot_result(result, out) + plot_telescopic(result, out)
-    if result.scene.get("kind") == "folding" or result.scene.get("name") == "folding":
-        from .folding_plots import plot_folding
-        figs += plot_folding(result, out)
-    return figs
+    """Every figure of the result's system kind (``run`` and ``plot``)."""
+    return system_kind(result.scene).figures(result, out)
 
 
 def cmd_list(args) -> int:
@@ -163,42 +149,11 @@ def cmd_list(args) -> int:
 
 
 def cmd_describe(args) -> int:
-    from .assemble import build_model
     scene = load_scene(args.scene, _overrides(args.set))
-    if scene.get("kind") == "telescopic":
-        from .telescopic import build_telescopic
-        from .telescopic_scene import params_from_scene
-        params = params_from_scene(scene)
-        if not params.flexible:
-            from .rigid_telescopic import RigidTelescopic
-            rig = RigidTelescopic(params)
-            print(f"scene {scene['name']}: {scene['description']}")
-            print("effects: " + ", ".join(f"{k}={'on' if v else 'off'}"
-                                          for k, v in scene["effects"].items()))
-            print("assembled contributions: rigid booms (kinematic limit)"
-                  + (", elastic ropes" if rig.elastic else ", inextensible rope" if rig.ropes else ""))
-            print(f"coordinates: {rig.n_dof}, DOF: {rig.n_dof}")
-            print(json.dumps({k: v for k, v in scene.items() if k != "source"}, indent=2))
-            return 0
-        ts = build_telescopic(params)
-        model = ts.model
-        if ts.contact is not None and not params.friction:
-            print("note: slider-spring distribution evaluated for the outputs only (friction off)")
-    elif scene.get("kind") == "folding":
-        from .folding import build_folding
-        from .folding_scene import params_from_scene as folding_params
-        model = build_folding(folding_params(scene)).model
-    else:
-        model, _, _ = build_model(scene)
     print(f"scene {scene['name']}: {scene['description']}")
     print("effects: " + ", ".join(f"{k}={'on' if v else 'off'}" for k, v in scene["effects"].items()))
-    print("assembled contributions: " + ", ".join(e.name for e in model.effects)
-          + "".join(f", {pe.name}" for pe in model.point_effects)
-          + "".join(f", {mf.name}" for mf in model.multiplier_forces)
-          + (f", {len(model.point_loads)} point load(s)" if model.point_loads else ""))
-    n_nl = sum(c.m for c in model.nonlinear)
-    print(f"coordinates: {model.n_coords}, linear constraints: {model.A.shape[0]}, "
-          f"nonlinear constraint rows: {n_nl}, DOF: {model.n_dof - n_nl}")
+    for line in system_kind(scene).describe(scene):
+        print(line)
     print(json.dumps({k: v for k, v in scene.items() if k != "source"}, indent=2))
     return 0
 
@@ -219,7 +174,7 @@ def cmd_plot(args) -> int:
 
 
 def cmd_sweep(args) -> int:
-    from .sweep import SweepError, parse_grid, run_sweep
+    from sim_core.sweep import SweepError, parse_grid, run_sweep
     grid = parse_grid(args.grid)
     fixed = _overrides(args.set)
     both = sorted(set(grid) & set(fixed))

@@ -67,7 +67,7 @@ class ElementEvaluationError(SimulationError):
 class StalledIntegration(SimulationError):
     """The integration stopped making progress: its accepted steps stayed so short that the
     rest of the run would take more steps than any run is allowed, or more wall time than its
-    budget leaves (see :class:`sim_core.simulate.StallMonitor`).
+    budget leaves (see :class:`sim_core.integrate.driver.StallMonitor`).
 
     Attributes
     ----------
@@ -85,7 +85,7 @@ class StalledIntegration(SimulationError):
 
 
 class SuspectResult(SimulationError):
-    """A finished run failed its own result checks (:func:`sim_core.simulate.check_result`) by
+    """A finished run failed its own result checks (:func:`sim_core.integrate.driver.check_result`) by
     so much that its outputs are not a solution of the model: e.g. its energy grew far beyond
     what the integration tolerance allows while nothing fed energy in.  The result is attached
     as ``.result`` (its ``error`` set), as for a failed solve.

@@ -70,7 +70,7 @@ def _fsync_dir(folder: Path) -> None:
         os.close(fd)
 
 
-def _json_default(obj):
+def json_default(obj):
     """numpy scalars/arrays as plain numbers/lists in the metadata (anything else as text)."""
     if isinstance(obj, np.generic):
         return obj.item()
@@ -83,7 +83,7 @@ def _json_default(obj):
 
 @dataclass
 class Result:
-    """Output of :func:`sim_core.simulate`.
+    """Output of :func:`sim_core.integrate.driver`.
 
     ``t`` (n,) in s; ``result[name]`` gives an output array whose first axis is time.
     ``stats`` holds solver statistics (wall time s, steps, RHS evaluations, ...), ``scene``
@@ -108,7 +108,7 @@ class Result:
     @property
     def suspect(self) -> bool:
         """The run finished but failed one of its own result checks (``stats["checks"]``,
-        :func:`sim_core.simulate.check_result`): its outputs may be wrong."""
+        :func:`sim_core.integrate.driver.check_result`): its outputs may be wrong."""
         return bool(self.stats.get("suspect", False))
 
     def failed_checks(self) -> dict:
@@ -133,7 +133,7 @@ class Result:
         """Write an .npz (arrays + JSON metadata) atomically."""
         import io
 
-        from . import __version__
+        from sim_core._version import __version__
         meta = {"stats": self.stats, "scene": self.scene, "error": self.error,
                 "versions": {"sim_core": __version__, "numpy": np.__version__}}
         try:
@@ -142,7 +142,7 @@ class Result:
         except ImportError:  # pragma: no cover
             pass
         buf = io.BytesIO()
-        np.savez_compressed(buf, t=self.t, __meta__=np.array(json.dumps(meta, default=_json_default)),
+        np.savez_compressed(buf, t=self.t, __meta__=np.array(json.dumps(meta, default=json_default)),
                             **{f"out__{k}": v for k, v in self.outputs.items()})
         atomic_write_bytes(path, buf.getvalue())
         return Path(path)

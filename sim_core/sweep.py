@@ -54,9 +54,10 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .errors import SceneError
-from .result import Result, atomic_write_bytes
-from .scene import load_scene
+from sim_core.api import load_scene, simulate
+from sim_core.errors import SceneError
+from sim_core.registry import system_kind
+from sim_core.result import Result, atomic_write_bytes, json_default
 
 STATUSES = ("ok", "failed", "skipped", "interrupted")
 RESULT_FILE = "result.npz"
@@ -99,7 +100,7 @@ def parse_grid(items: list[str] | None) -> dict[str, list[str]]:
     """``["payload.mass=20000,25000", ...]`` (the ``--grid`` options) -> {key: [values]}.
 
     Values stay text; they are parsed as TOML values when the override is applied
-    (:func:`sim_core.scene.apply_overrides`).  Raises SceneError naming the key for a missing
+    (:func:`sim_core.scene.io.apply_overrides`).  Raises SceneError naming the key for a missing
     ``=``, an empty key or value, a key given twice or a value repeated within a key."""
     grid: dict[str, list[str]] = {}
     for item in items or []:
@@ -267,9 +268,8 @@ def run_case(scene: dict) -> dict:
     """Simulate one validated scene; never raises for a failed simulation.
 
     Returns {status "ok"/"failed", error_type, error (one line), wall_s (wall time of
-    :func:`sim_core.simulate` incl. model build, s), n_steps, outcomes, stats, result (the
+    :func:`sim_core.integrate.driver` incl. model build, s), n_steps, outcomes, stats, result (the
     Result, or the partial result a failed solver attached, or None), t_fail_s}."""
-    from .simulate import simulate
     t0 = time.perf_counter()
     rec: dict[str, Any] = {"status": "ok", "error_type": None, "error": None, "t_fail_s": None}
     try:
@@ -295,8 +295,7 @@ def run_case(scene: dict) -> dict:
 # -- case folders ------------------------------------------------------------------------------
 
 def _json_bytes(obj) -> bytes:
-    from .result import _json_default
-    return json.dumps(obj, indent=2, default=_json_default).encode()
+    return json.dumps(obj, indent=2, default=json_default).encode()
 
 
 def _write_case(out: Path, case: dict, rec: dict, plots: bool) -> None:
@@ -318,8 +317,7 @@ def _write_case(out: Path, case: dict, rec: dict, plots: bool) -> None:
                    "outcomes": rec["outcomes"], **rec.get("stats", {})}
         atomic_write_bytes(tmp / CASE_SUMMARY, _json_bytes(summary))
         if plots and res is not None and rec["status"] == "ok":
-            from .cli import _figures
-            _figures(res, tmp)
+            system_kind(res.scene).figures(res, tmp)
         old = None
         if final.exists():
             old = out / f".{case['name']}.old-{uuid.uuid4().hex}"
@@ -428,7 +426,7 @@ def summary_figure(path: Path, rows: list[dict], keys: list[str], title: str) ->
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from .plots import save_figure
+    from sim_core.figures import save_figure
 
     good = [r for r in rows if r["status"] in ("ok", "skipped")]
     outcome_keys = [k for k in summary_fields(rows, keys)

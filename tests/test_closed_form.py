@@ -9,8 +9,8 @@ import pytest
 from scipy.integrate import quad, solve_ivp
 from scipy.linalg import eigh_tridiagonal
 
-from sim_core.drive_profiles import CubicSmoothstepSchedule
 from sim_core.errors import SceneError
+from sim_core.physics.drive_profiles import CubicSmoothstepSchedule
 from sim_core.validation import closed_form as cf
 
 TH = math.radians(60.0)

@@ -1,4 +1,4 @@
-"""Tests of sim_core.drive_profiles (SCENARIOS A4 cubic schedule, B Eq. 52 profile)."""
+"""Tests of sim_core.physics.drive_profiles (SCENARIOS A4 cubic schedule, B Eq. 52 profile)."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from sim_core.drive_profiles import CubicSmoothstepSchedule, Eq52Profile, MotionSample
 from sim_core.errors import SceneError
+from sim_core.physics.drive_profiles import CubicSmoothstepSchedule, Eq52Profile, MotionSample
 
 H = 1e-6  # finite-difference step, s
 

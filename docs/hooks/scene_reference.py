@@ -4,10 +4,10 @@
 ``on_page_markdown`` replaces it with one section per scene kind.  Nothing is written by hand:
 
 * keys, types, defaults and allowed ranges come from the validators' source, read with ``ast``:
-  every call of the helpers of :mod:`sim_core.scene` (``number``, ``boolean``, ``choice``,
+  every call of the helpers of :mod:`sim_core.scene.fields` (``number``, ``boolean``, ``choice``,
   ``vector``) and every ``check_keys`` set of the validator functions
-  (``sim_core.scene.validate`` with ``solver_table``, ``sim_core.telescopic_scene.
-  validate_telescopic``, ``sim_core.folding_scene.validate_folding``, and the ``_check*``
+  (``sim_core.systems.beam.schema.validate`` with ``solver_table``, ``sim_core.systems.telescopic.schema.
+  validate_telescopic``, ``sim_core.systems.folding.schema.validate_folding``, and the ``_check*``
   helpers they call);
 * defaults that the source computes (for example the [solver] defaults of each scene kind) are
   read from the validator's own output for a minimal scene;
@@ -41,15 +41,15 @@ UNIT = rf"{UNIT_ATOM}(?:/{UNIT_ATOM})*(?:\s{UNIT_ATOM}(?:/{UNIT_ATOM})*)*"
 # (title, value of ``kind``, module, validator, minimal raw scene).  Keys given in the minimal
 # scene are the required ones (the validator rejects a scene without them).
 KINDS = [
-    ("Beam scenes (no `kind`)", None, "sim_core.scene", "validate",
+    ("Beam scenes (no `kind`)", None, "sim_core.systems.beam.schema", "validate",
      {"solver": {"t_end": 1.0},
       "beams": [{"length": 1.0, "section": {k: 1.0 for k in
                                             ("E", "G", "rho", "A", "I_t", "I_b", "J")}}],
       "boundary": [{"end": "left", "kind": "clamped"}],
       "point_loads": [{"s": 0.5, "force": [0.0, 0.0, -1.0]}]}),
-    ("Telescopic scenes (`kind = \"telescopic\"`)", "telescopic", "sim_core.telescopic_scene",
+    ("Telescopic scenes (`kind = \"telescopic\"`)", "telescopic", "sim_core.systems.telescopic.schema",
      "validate_telescopic", {"kind": "telescopic"}),
-    ("Folding scenes (`kind = \"folding\"`)", "folding", "sim_core.folding_scene",
+    ("Folding scenes (`kind = \"folding\"`)", "folding", "sim_core.systems.folding.schema",
      "validate_folding", {"kind": "folding"}),
 ]
 
@@ -491,9 +491,10 @@ def _cell(text: str) -> str:
 # -- the page -------------------------------------------------------------------------------------
 
 def _kind_section(title, kind, modname, funcname, minimal) -> str:
-    from sim_core.scene import load_scene, shipped_scenes
+    from sim_core import load_scene
+    from sim_core.scene.io import shipped_scenes
 
-    scene_mod, scene_funcs, scene_consts = _module_info("sim_core.scene")
+    scene_mod, scene_funcs, scene_consts = _module_info("sim_core.scene.fields")
     mod, funcs, consts = _module_info(modname)
     registry = {n: (fn, scene_funcs, scene_consts) for n, fn in scene_funcs.items()}
     registry.update({n: (fn, funcs, consts) for n, fn in funcs.items()})
@@ -512,7 +513,8 @@ def _kind_section(title, kind, modname, funcname, minimal) -> str:
     required = set(_flatten(minimal))
 
     docs = {}
-    for m in (mod, scene_mod):
+    # the [solver] units are written once, in the beam schema's docstring
+    for m in (mod, importlib.import_module("sim_core.systems.beam.schema")):
         for name, text in _segments(m.__doc__ or "").items():
             docs.setdefault(name, text)
     own_docs = _segments(mod.__doc__ or "")

@@ -32,14 +32,18 @@ from typing import Sequence
 import numpy as np
 from scipy.optimize import brentq
 
-from ..drive_profiles import ArrayLike, DriveProfile
-from ..errors import SceneError
+from sim_core.errors import SceneError
+from sim_core.physics.drive_profiles import ArrayLike, DriveProfile
+from sim_core.systems.telescopic.luffing import (  # noqa: F401  (re-exported: the reference
+    R1_DEFAULT,  # geometry of A2)
+    R2_DEFAULT,
+    RBAR1_DEFAULT,
+    RBAR3_DEFAULT,
+    LuffingGeometry,
+    luffing_geometry,
+    luffing_rotation,
+)
 
-# --- A2 mounting points (m): global r1 (D1), r2 (D2); boom-1 left-section rbar1 (D1), rbar3 (D3).
-R1_DEFAULT = (-0.556, 0.0, 0.350)
-R2_DEFAULT = (0.100, 0.0, 0.050)
-RBAR1_DEFAULT = (-0.956, 0.0, 0.556)
-RBAR3_DEFAULT = (7.250, 0.0, -0.556)
 # --- A1 Table 2: mass per length (kg/m) and mass-centre offset z_c along e_b (m), booms 1..3.
 M_PER_LENGTH_DEFAULT = (318.86, 304.07, 289.27)
 Z_C_DEFAULT = (0.045, 0.044, 0.043)
@@ -161,52 +165,6 @@ def bigoni_sleeve(P: float, ell: float, EI: float) -> SleeveReference:
     ell, EI = _pos("ell", ell), _pos("EI", EI)
     M = P * ell
     return SleeveReference(P * ell**3 / (3 * EI), M, M**2 / (2 * EI))
-
-
-# ----------------------------------------------------------------------------- A2 geometry
-def luffing_rotation(theta: float) -> np.ndarray:
-    """PD rotation R(theta) (SCENARIOS A2): boom-1 section components -> global, theta in rad."""
-    ct, st = math.cos(theta), math.sin(theta)
-    return np.array([[ct, 0.0, -st], [0.0, 1.0, 0.0], [st, 0.0, ct]])
-
-
-@dataclass(frozen=True)
-class LuffingGeometry:
-    """Initial (rigid) boom-1 geometry at luffing angle theta; global positions in m.
-
-    rotation: R(theta); origin: boom-1 left-section origin O = r1 - R rbar1; d1, d2, d3: pivot,
-    cylinder base, cylinder head; cylinder_length = |D3 - D2|; lever = distance from D1 to the
-    line D2-D3; e_s = boom axis direction R e_x.
-    """
-
-    theta: float
-    rotation: np.ndarray
-    origin: np.ndarray
-    d1: np.ndarray
-    d2: np.ndarray
-    d3: np.ndarray
-    cylinder_length: float
-    lever: float
-    e_s: np.ndarray
-
-
-def luffing_geometry(theta: float, r1: Sequence[float] = R1_DEFAULT,
-                     r2: Sequence[float] = R2_DEFAULT, rbar1: Sequence[float] = RBAR1_DEFAULT,
-                     rbar3: Sequence[float] = RBAR3_DEFAULT) -> LuffingGeometry:
-    """Geometry of Zhao-Qi-Wang 2024 Sec. 9 / SCENARIOS A2: L_cyl = |r1 - r2 + R(rbar3 - rbar1)|.
-
-    theta in rad; r1, r2 global (m); rbar1, rbar3 in boom-1 left-section components (m).
-    At theta = 60 deg: L_cyl = 8.147 m, O = (0.4035, 0, 0.8999) m, lever = 0.714 m.
-    """
-    R = luffing_rotation(theta)
-    r1a, r2a = np.asarray(r1, float), np.asarray(r2, float)
-    rb1, rb3 = np.asarray(rbar1, float), np.asarray(rbar3, float)
-    origin = r1a - R @ rb1                    # D1 is fixed both globally and in the boom
-    d3 = origin + R @ rb3
-    cyl = d3 - r2a                            # = r1 - r2 + R (rbar3 - rbar1)
-    L_cyl = float(np.linalg.norm(cyl))
-    lever = float(np.linalg.norm(np.cross(r1a - r2a, cyl / L_cyl)))
-    return LuffingGeometry(theta, R, origin, r1a, r2a, d3, L_cyl, lever, R[:, 0].copy())
 
 
 def boom3_top_centre(theta: float, L_s: ArrayLike, boom_length: float = 10.0,

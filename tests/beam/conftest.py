@@ -2,10 +2,10 @@
 
 import numpy as np
 
-from sim_core.assemble import reference_basis
-from sim_core.beam.moving_node_beam import Beam, BeamSection
-from sim_core.effects import Elasticity, Gravity, Inertia
-from sim_core.model import Model, boundary_condition
+from sim_core.model.boundary import boundary_condition, reference_basis
+from sim_core.model.model import Model
+from sim_core.physics.beam.moving_node_beam import Beam, BeamSection
+from sim_core.physics.effects import Elasticity, Gravity, Inertia
 
 E, G_MOD, RHO = 2.1e11, 8.0e10, 7850.0
 L = 10.0

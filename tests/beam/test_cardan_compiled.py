@@ -1,10 +1,10 @@
-"""The compiled section-state loop equals the numpy reference (sim_core.beam.cardan)."""
+"""The compiled section-state loop equals the numpy reference (sim_core.physics.beam.cardan)."""
 
 import numpy as np
 import pytest
 
-from sim_core.beam import cardan_compiled
-from sim_core.beam.cardan import section_state, section_state_numpy
+from sim_core.physics.beam import _cardan_numba as cardan_compiled
+from sim_core.physics.beam.cardan import section_state, section_state_numpy
 
 FIELDS = ("eps", "deps_dx", "angles", "dpsi_drp", "tmat", "frame", "psi_prime")
 

@@ -3,12 +3,16 @@
 import numpy as np
 import pytest
 
-from sim_core.effects import PointLoad
-from sim_core.statics import linear_modes, static_equilibrium
-from sim_core.validation.closed_form import (cantilever_bending_omegas, cantilever_tip_load,
-                                             cantilever_uniform_load, fixed_free_axial_f1,
-                                             fixed_free_torsion_f1)
-from tests.beam.conftest import A, E, G_MOD, I_B, I_T, L, RHO, cantilever, section
+from sim_core.model.statics import linear_modes, static_equilibrium
+from sim_core.physics.effects import PointLoad
+from sim_core.validation.closed_form import (
+    cantilever_bending_omegas,
+    cantilever_tip_load,
+    cantilever_uniform_load,
+    fixed_free_axial_f1,
+    fixed_free_torsion_f1,
+)
+from tests.beam.conftest import G_MOD, I_B, I_T, RHO, A, E, L, cantilever, section
 
 
 def _solve_static(m, Q0):

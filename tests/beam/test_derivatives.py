@@ -1,6 +1,6 @@
 """Jacobians and convective terms of the moving-node element against finite differences.
 
-Every analytic derivative of sim_core.beam (Cardan angles, strains, material Jacobians at fixed
+Every analytic derivative of sim_core.physics.beam (Cardan angles, strains, material Jacobians at fixed
 s, the complex-step convective terms, the elastic force as energy gradient) is compared with
 central differences; tolerances are set by the O(h^2) truncation + round-off of the differences.
 """
@@ -8,12 +8,12 @@ central differences; tolerances are set by the O(h^2) truncation + round-off of 
 import numpy as np
 import pytest
 
-from sim_core.assemble import reference_basis
-from sim_core.beam.cardan import section_state
-from sim_core.beam.moving_node_beam import Beam, SplineElement
-from sim_core.effects import Elasticity, Inertia
-from sim_core.model import Model, _CSTEP
-
+from sim_core.model.boundary import reference_basis
+from sim_core.model.model import Model
+from sim_core.physics.beam.cardan import section_state
+from sim_core.physics.beam.moving_node_beam import Beam, SplineElement
+from sim_core.physics.complex_step import COMPLEX_STEP as _CSTEP
+from sim_core.physics.effects import Elasticity, Inertia
 from tests.beam.conftest import L, section
 
 

@@ -3,13 +3,13 @@
 import numpy as np
 import pytest
 
-from sim_core.assemble import reference_basis
-from sim_core.beam.moving_node_beam import Beam
-from sim_core.effects import Elasticity, Inertia, PointLoad
-from sim_core.integrators import integrate_generalized_alpha
-from sim_core.model import Model, boundary_condition
+from sim_core.integrate import integrate_generalized_alpha
+from sim_core.model.boundary import boundary_condition, reference_basis
+from sim_core.model.model import Model
+from sim_core.physics.beam.moving_node_beam import Beam
+from sim_core.physics.effects import Elasticity, Inertia, PointLoad
 from sim_core.validation.closed_form import fryba_deflection
-from tests.beam.conftest import A, E, I_T, L, RHO, section
+from tests.beam.conftest import I_T, RHO, A, E, L, section
 
 
 def _simply_supported(load):
@@ -53,8 +53,8 @@ def test_free_vibration_energy_conserved_to_solver_tolerance():
     Explicit RK45 is stiffness-limited here (highest mode ~350 x the first), hence `slow`."""
     from scipy.integrate import solve_ivp
 
-    from sim_core.beam.moving_node_beam import BeamSection
-    from sim_core.statics import static_equilibrium
+    from sim_core.model.statics import static_equilibrium
+    from sim_core.physics.beam.moving_node_beam import BeamSection
     sec = BeamSection(EA=E * 1e-2, GJ=8e10 * 2e-4, EI_t=E * 1e-4, EI_b=E * 1e-4, rhoA=RHO * 1e-2,
                       J_s=RHO * 2e-4)
     b = Beam("b", 4.0, sec, (0.0, 4.0), n_nodes=3, reference_basis=reference_basis([1, 0, 0]))

@@ -19,11 +19,11 @@ are ~1e-15 (M) and ~1e-13 (F) of the maximum.
 import numpy as np
 import pytest
 
-from sim_core.assemble import reference_basis
-from sim_core.beam import element_compiled
-from sim_core.beam.moving_node_beam import Beam, BeamSection
-from sim_core.effects import Elasticity, Gravity, Inertia, StressFilter
-from sim_core.model import Model, boundary_condition
+from sim_core.model.boundary import boundary_condition, reference_basis
+from sim_core.model.model import Model
+from sim_core.physics import _effects_numba as element_compiled
+from sim_core.physics.beam.moving_node_beam import Beam, BeamSection
+from sim_core.physics.effects import Elasticity, Gravity, Inertia, StressFilter, effect_parameters
 
 pytestmark = pytest.mark.skipif(not element_compiled.AVAILABLE, reason="numba not installed")
 
@@ -81,7 +81,7 @@ def test_equals_model_element_mass_force(n_nodes, which):
     effects = _effects(EFFECT_SETS[which])
     model, el, qe, qde, sec = _moving_element(n_nodes, effects)
     M_ref, F_ref = model.element_mass_force(model.element_context(0.0, el, qe, qde))
-    kw = element_compiled.effect_parameters(effects, sec)
+    kw = effect_parameters(effects, sec)
     M, F = element_compiled.element_mass_force(el, qe, qde, **kw)
     assert M.shape == (el.n_coords, el.n_coords) and F.shape == (el.n_coords,)
     _check(F, F_ref, "F")
@@ -122,31 +122,31 @@ def test_explicit_arguments():
 def test_uncovered_effects_rejected():
     sec = BeamSection(EA=1.0, GJ=1.0, EI_t=1.0, EI_b=1.0, rhoA=1.0, J_s=1.0, z_c=0.04)
     with pytest.raises(ValueError):
-        element_compiled.effect_parameters([Inertia()], sec)
+        effect_parameters([Inertia()], sec)
     with pytest.raises(ValueError):
-        element_compiled.effect_parameters([Inertia(), Inertia()],
+        effect_parameters([Inertia(), Inertia()],
                                            BeamSection(1.0, 1.0, 1.0, 1.0, 1.0, 1.0))
 
 
 @pytest.mark.parametrize("n_nodes", [3, 9])
 def test_quadrature_row_tables(n_nodes):
-    """The rows of the arbitrary-point polynomial _D_all at the Gauss points are the position
-    and torsion tables _q_phi, _q_psi (the real parts the convective terms take from them), and
-    _q_drows are their xi-derivatives (against central differences at xi +- 1e-6)."""
+    """The rows of the arbitrary-point polynomial D_all at the Gauss points are the position
+    and torsion tables q_phi, q_psi (the real parts the convective terms take from them), and
+    q_drows are their xi-derivatives (against central differences at xi +- 1e-6)."""
     model, el, qe, qde, sec = _moving_element(n_nodes, _effects(ALL))
-    el._basis_tables()
+    el.basis_tables()
     na, nt = el.n + 4, 2 * el.n
-    xi, sub = el._q_pos - el.q_sub, el.q_sub
+    xi, sub = el.q_pos - el.q_sub, el.q_sub
 
     def rows_at(x):
-        return np.einsum("gp,gpk->gk", x[:, None] ** np.arange(6), el._D_all[sub])
+        return np.einsum("gp,gpk->gk", x[:, None] ** np.arange(6), el.D_all[sub])
     rows = rows_at(xi)
     G = rows.shape[0]
-    np.testing.assert_allclose(rows[:, :7 * na].reshape(G, 7, na), el._q_phi, rtol=0,
-                               atol=1e-12 * np.abs(el._q_phi).max())
-    np.testing.assert_allclose(rows[:, 7 * na:7 * na + 5 * nt].reshape(G, 5, nt), el._q_psi,
-                               rtol=0, atol=1e-12 * np.abs(el._q_psi).max())
+    np.testing.assert_allclose(rows[:, :7 * na].reshape(G, 7, na), el.q_phi, rtol=0,
+                               atol=1e-12 * np.abs(el.q_phi).max())
+    np.testing.assert_allclose(rows[:, 7 * na:7 * na + 5 * nt].reshape(G, 5, nt), el.q_psi,
+                               rtol=0, atol=1e-12 * np.abs(el.q_psi).max())
     h = 1e-6
-    drows = el._q_drows
+    drows = el.q_drows
     np.testing.assert_allclose(drows, (rows_at(xi + h) - rows_at(xi - h)) / (2 * h), rtol=0,
                                atol=1e-6 * np.abs(drows).max())

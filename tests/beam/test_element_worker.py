@@ -1,4 +1,4 @@
-"""The persistent element worker (sim_core/beam/element_worker.py) returns exactly the batch.
+"""The persistent element worker (sim_core/model/workers.py) returns exactly the batch.
 
 The worker runs the same compiled batch as a direct call, on another thread, with its inputs and
 outputs in a mailbox handed over by one atomic state word.  So its result must equal the direct
@@ -19,9 +19,9 @@ import numpy as np
 import pytest
 
 from sim_core import load_scene
-from sim_core.beam import element_worker
-from sim_core.telescopic import build_telescopic
-from sim_core.telescopic_scene import params_from_scene
+from sim_core.model import workers as element_worker
+from sim_core.systems.telescopic.build import build_telescopic
+from sim_core.systems.telescopic.schema import params_from_scene
 
 pytestmark = pytest.mark.skipif(not element_worker.AVAILABLE,
                                 reason="numba atomics or libc usleep not available")

@@ -1,12 +1,16 @@
-"""Load continuation of the static equilibrium (sim_core.statics.load_continuation): on a
+"""Load continuation of the static equilibrium (sim_core.model.statics.load_continuation): on a
 cantilever whose equilibrium Newton finds directly, the traced path ends on the same
 equilibrium; the weights are restored after scaling."""
 
 import numpy as np
 import pytest
 
-from sim_core.statics import (EquilibriumPath, constrained_static_equilibrium,
-                              gravity_scaled, load_continuation)
+from sim_core.model.statics import (
+    EquilibriumPath,
+    constrained_static_equilibrium,
+    gravity_scaled,
+    load_continuation,
+)
 
 from .conftest import cantilever
 

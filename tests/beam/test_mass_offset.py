@@ -6,11 +6,11 @@ import math
 import numpy as np
 import pytest
 
-from sim_core.assemble import reference_basis
-from sim_core.beam.moving_node_beam import Beam, BeamSection
-from sim_core.effects import Elasticity, Gravity, Inertia, PointLoad
-from sim_core.model import Model, boundary_condition
-from sim_core.statics import static_equilibrium
+from sim_core.model.boundary import boundary_condition, reference_basis
+from sim_core.model.model import Model
+from sim_core.model.statics import static_equilibrium
+from sim_core.physics.beam.moving_node_beam import Beam, BeamSection
+from sim_core.physics.effects import Elasticity, Gravity, Inertia
 
 E, RHO, G_MOD = 2.1e11, 7850.0, 8.0e10
 A, I = 1e-2, 1e-4
@@ -76,7 +76,7 @@ def test_offset_convective_forces_do_no_work(offset, rng):
     difference of the assembled mass matrix along Qd (h = 1e-5: truncation ~h^2 ~ 1e-10
     relative).  Tolerance 1e-7.  The same check with the offset's omega x (omega x d) term
     dropped fails by orders of magnitude (shown below), so the test can fail."""
-    import sim_core.effects as eff
+    import sim_core.physics.effects as eff
     model, b, _ = _cantilever(*offset, [Inertia()])
     Q, Qd = _random_state(model, b, rng)
 

@@ -7,9 +7,10 @@ clamp eliminated exactly, at any state consistent with the constraints.
 
 import numpy as np
 
-from sim_core.constraints import angle_coincidence, material_point, point_coincidence
-from sim_core.effects import PointLoad
-from sim_core.model import Model, boundary_condition
+from sim_core.model.boundary import boundary_condition
+from sim_core.model.model import Model
+from sim_core.physics.constraints import angle_coincidence, material_point, point_coincidence
+from sim_core.physics.effects import PointLoad
 from tests.beam.conftest import cantilever
 
 
@@ -45,8 +46,9 @@ def test_selection_fast_path_equals_the_dense_projection():
     """Model.reduced_mass_force takes P^T M P as a sub-matrix when P only selects (and signs)
     coordinates; the dense products give the same numbers (bitwise: one non-zero term per sum,
     times +-1).  A P whose columns mix coordinates keeps the dense route."""
-    from sim_core.model import _selection
-    from sim_core.telescopic import TelescopicParams, build_telescopic
+    from sim_core.model.model import _selection
+    from sim_core.systems.telescopic.params import TelescopicParams
+    from sim_core.systems.telescopic.build import build_telescopic
     m = build_telescopic(TelescopicParams(n_nodes=3)).model
     assert m._sel is not None
     rng = np.random.default_rng(1)

@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from sim_core.beam import point_compiled
-from sim_core.beam.moving_node_beam import Beam, BeamSection
-from sim_core.assemble import reference_basis
+from sim_core.model.boundary import reference_basis
+from sim_core.physics.beam import _moving_node_beam_numba as point_compiled
+from sim_core.physics.beam.moving_node_beam import Beam, BeamSection
 
 
 def _bent_element(n_nodes=9):
@@ -53,7 +53,7 @@ def test_compiled_kernels_follow_numpy_error_handling():
     non-finite result where np.errstate says raise (the integrator's right-hand side: a blown-up
     stage is then rejected and retried, tests/scenes/test_partial_result.py), and otherwise let
     NaN propagate."""
-    from sim_core.beam.element_compiled import element_mass_force
+    from sim_core.physics._effects_numba import element_mass_force
 
     el, qe, qde = _bent_element(5)
     bad = qe.copy()

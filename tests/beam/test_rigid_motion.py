@@ -3,10 +3,10 @@
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from sim_core.assemble import reference_basis
-from sim_core.beam.moving_node_beam import Beam
-from sim_core.effects import Elasticity
-from sim_core.model import Model
+from sim_core.model.boundary import reference_basis
+from sim_core.model.model import Model
+from sim_core.physics.beam.moving_node_beam import Beam
+from sim_core.physics.effects import Elasticity
 from tests.beam.conftest import L, section
 
 

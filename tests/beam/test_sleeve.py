@@ -7,10 +7,10 @@ coordinate s_1(t) is prescribed: material flows through the node (Section 3).
 import numpy as np
 import pytest
 
-from sim_core.assemble import build_model
-from sim_core.integrators import integrate_generalized_alpha
-from sim_core.scene import load_scene
-from sim_core.statics import static_equilibrium
+from sim_core import load_scene
+from sim_core.integrate import integrate_generalized_alpha
+from sim_core.model.statics import static_equilibrium
+from sim_core.systems.beam.build import build_model
 from sim_core.validation.closed_form import bigoni_sleeve
 
 

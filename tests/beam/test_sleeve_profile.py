@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from sim_core import SceneError, load_scene, simulate
-from sim_core.drive_profiles import CubicSmoothstepSchedule
+from sim_core.physics.drive_profiles import CubicSmoothstepSchedule
 
 SCENE = "beam_through_sleeve"
 CUBIC = {"boundary.0.profile": "cubic", "boundary.0.t_ramp": 0.5, "boundary.0.t_hold_end": 1.0}

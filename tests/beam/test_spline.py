@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from sim_core.beam.spline import spline_basis, xi_powers
+from sim_core.physics.beam.spline import spline_basis, xi_powers
 
 
 def _eval(n, coeffs, s1, sn, s):

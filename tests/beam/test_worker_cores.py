@@ -1,4 +1,4 @@
-"""A simulation uses the cores it is given, and no more (sim_core.beam.element_worker.Governor).
+"""A simulation uses the cores it is given, and no more (sim_core.model.workers.Governor).
 
 The element worker spins while it waits, and the caller spins while it waits for the worker:
 that pays only where the worker has a core of its own.  Checked here:
@@ -20,9 +20,10 @@ import os
 import numpy as np
 import pytest
 
-from sim_core.beam import element_worker
-from sim_core.beam.element_worker import Governor
-from sim_core.telescopic import TelescopicParams, build_telescopic
+from sim_core.model import workers as element_worker
+from sim_core.model.workers import Governor
+from sim_core.systems.telescopic.params import TelescopicParams
+from sim_core.systems.telescopic.build import build_telescopic
 
 needs_worker = pytest.mark.skipif(not element_worker.AVAILABLE,
                                   reason="numba atomics or libc usleep not available")
@@ -82,7 +83,7 @@ def _same(a, b):
 @needs_worker
 def test_one_core_or_off_starts_no_thread(paper_small, monkeypatch):
     """One core (or mode "off"): no worker and no thread pool; the same right-hand side."""
-    from sim_core import model as model_module
+    from sim_core.model import workers
     m, ys = paper_small
     ref = _rhs_with(m, "on", ys)
     assert m.__dict__.get("_spin_worker") is not None
@@ -90,7 +91,7 @@ def test_one_core_or_off_starts_no_thread(paper_small, monkeypatch):
 
     def no_pool():
         raise AssertionError("the thread pool was used")
-    monkeypatch.setattr(model_module, "_element_worker", no_pool)
+    monkeypatch.setattr(workers, "thread_pool", no_pool)
     for cores, how in ((1, "auto"), (2, "off")):
         got = _rhs_with(m, how, ys, cores=cores)
         assert m.__dict__.get("_spin_worker") is None
@@ -215,7 +216,7 @@ def test_worker_sharing_the_callers_core_is_stopped(paper_small):
 _BLAS_PROBE = """
 import ctypes, json, numpy, scipy.linalg
 def counts():
-    from sim_core.beam import element_worker as w
+    from sim_core.model import workers as w
     out = {}
     for path in w._openblas_libraries():
         lib = ctypes.CDLL(path)
@@ -225,7 +226,7 @@ def counts():
                 out[path] = int(getattr(lib, name)())
     return out
 before = counts()
-from sim_core.beam import element_worker
+from sim_core.model import workers as element_worker
 element_worker.Governor()
 print(json.dumps([before, counts()]))
 """

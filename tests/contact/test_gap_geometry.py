@@ -2,7 +2,7 @@
 
 import pytest
 
-from sim_core.contact import SliderGeometry
+from sim_core.physics.contact import SliderGeometry
 
 
 @pytest.mark.parametrize("pair", [1, 2])

@@ -1,4 +1,4 @@
-"""Tests of sim_core.section_properties: paper Table 1/2, closed-form checks, validation."""
+"""Tests of sim_core.physics.sections: paper Table 1/2, closed-form checks, validation."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import pytest
 from scipy import integrate
 
 from sim_core.errors import SceneError
-from sim_core.section_properties import (
+from sim_core.physics.sections import (
     PAPER_TABLE2,
     USection,
     annular_sector_moments,

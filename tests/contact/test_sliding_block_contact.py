@@ -1,4 +1,4 @@
-"""Tests of sim_core.contact.sliding_block_contact (paper Section 8.2-8.3, SCENARIOS A6).
+"""Tests of sim_core.physics.contact.sliding_block_contact (paper Section 8.2-8.3, SCENARIOS A6).
 
 Each test checks a physical or mathematical fact; every tolerance is derived in a comment.
 Loads are of the order of the paper's 25 t case (region forces 1e5-1e6 N, moments 1e5 N m).
@@ -11,7 +11,8 @@ import math
 import numpy as np
 import pytest
 
-from sim_core.contact import (
+from sim_core.errors import SimulationError
+from sim_core.physics.contact import (
     ContactSolution,
     ContactSolveError,
     FrictionLaw,
@@ -21,8 +22,7 @@ from sim_core.contact import (
     contact_residual,
     solve_micro_motion,
 )
-from sim_core.contact import micro_motion_compiled
-from sim_core.errors import SimulationError
+from sim_core.physics.contact import _sliding_block_contact_numba as micro_motion_compiled
 
 RTOL_SOLVE = 1e-11     # solver default: max |S R| <= 1e-11 max |S c|
 EQ_TOL = 1e-9          # brief: equations satisfied to 1e-9 relative (100x margin on RTOL_SOLVE)
@@ -585,7 +585,7 @@ def test_normal_load_equals_the_full_solve(compiled, monkeypatch):
     """normal_load (the friction Newton's lean path: no ContactSolution; the Newton matrices
     formed once per mu) gives the full solve's normal load, its gradient and micro-motions,
     cold and warm started, and zero at zero load."""
-    from sim_core.contact.sliding_block_contact import newton_matrices, normal_load
+    from sim_core.physics.contact.sliding_block_contact import newton_matrices, normal_load
     if compiled and not micro_motion_compiled.AVAILABLE:
         pytest.skip("numba not installed")
     monkeypatch.setattr(micro_motion_compiled, "AVAILABLE", compiled)

@@ -16,12 +16,12 @@ N_OUT = 601
 
 
 def params():
-    from sim_core.telescopic import TelescopicParams
+    from sim_core.systems.telescopic.params import TelescopicParams
     return TelescopicParams(n_nodes=3, friction=False, **WINDOW)
 
 
 def run_full():
-    from sim_core.telescopic import simulate_telescopic
+    from sim_core.systems.telescopic.build import simulate_telescopic
     return simulate_telescopic(params(), T_END, N_OUT, 1e-6, 1e-7)
 
 

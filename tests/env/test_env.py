@@ -88,7 +88,7 @@ def test_angle_randomisation_draws_inside_the_tables_and_is_seeded():
     """angle_range draws the luffing angle per reset from the env's seeded generator, within
     the tabulated range; the ROM responds to it (the first bending mode of the tables differs
     between the ends of the range) and the same seed gives the same angle and trajectory."""
-    from sim_core.modal_telescopic import allowed_ranges
+    from sim_core.systems.telescopic.modal import allowed_ranges
     _, (a_lo, a_hi), _ = allowed_ranges()
     assert a_hi - a_lo >= 30.0                           # 45-75 deg tables
     env = TelescopicBoomEnv(angle_range=(a_lo, a_hi), payload_range=(20000.0, 30000.0))
@@ -108,7 +108,7 @@ def test_angle_randomisation_draws_inside_the_tables_and_is_seeded():
         runs.append(np.array(traj))
     np.testing.assert_array_equal(runs[0], runs[1])
     assert np.all(np.isfinite(runs[0])) and np.max(np.abs(runs[0][:, 5:7])) > 1e-5
-    from sim_core.modal_telescopic import tables_for
+    from sim_core.systems.telescopic.modal import tables_for
     w = [tables_for(25000.0, a, 1).coefficients(5.0)[0, 0] for a in (a_lo, a_hi)]
     assert abs(w[0] - w[1]) > 1e-3 * w[0]
 
@@ -128,7 +128,7 @@ def test_cubic_schedule_as_actions_reproduces_scene():
     tip response equals sim_core.simulate on the rl scene, which uses the same kinematics and
     the same ROM (agreement to round-off)."""
     import sim_core
-    from sim_core.drive_profiles import CubicSmoothstepSchedule
+    from sim_core.physics.drive_profiles import CubicSmoothstepSchedule
     sc = sim_core.load_scene("telescopic_extraction_rl")
     res = sim_core.simulate(sc)
     d = sc["drive"]

@@ -97,7 +97,7 @@ def test_observed_parameters_are_the_episode_parameters_normalised():
     tables' range (float32 rounding: 6e-8), constant during the episode; the paper's 25 t and
     60 deg are the centre 0 and the range ends map to -1 and +1; the first 9 entries are the
     observation without the option."""
-    from sim_core.modal_telescopic import allowed_ranges
+    from sim_core.systems.telescopic.modal import allowed_ranges
     (p_lo, p_hi), (a_lo, a_hi), _ = allowed_ranges()
     env = TelescopicBoomEnv(observe_parameters=True, **RANGES)
     plain = TelescopicBoomEnv(**RANGES)

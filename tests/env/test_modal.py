@@ -1,4 +1,4 @@
-"""Modal ROM (sim_core.modal_telescopic) against the full sim_core model.
+"""Modal ROM (sim_core.systems.telescopic.modal) against the full sim_core model.
 
 Fast tests: the shipped tables, the scene route and the ROM's own numerics.  Slow test: the
 coarse full model (n_nodes = 3, frictionless, the discretisation the tables were built from)
@@ -9,7 +9,7 @@ on a short dynamic stroke window (tests/env/full_window.py, several minutes on a
 import numpy as np
 import pytest
 
-from sim_core.modal_telescopic import ModalROM, allowed_ranges, load_raw, tables_for
+from sim_core.systems.telescopic.modal import ModalROM, allowed_ranges, load_raw, tables_for
 
 from .full_window import N_OUT, T_END, WINDOW, params, run_full
 
@@ -94,7 +94,7 @@ def _peak_frequency(t, x):
 
 @pytest.mark.slow
 def test_rom_matches_full_model_on_a_dynamic_window():
-    from sim_core.modal_telescopic import simulate_modal
+    from sim_core.systems.telescopic.modal import simulate_modal
     full = run_full()
     rom = simulate_modal(params(), 4, T_END, N_OUT, dt_max=0.01)
     # ROM kinematics: chord rule, <= N h^3 max|jerk| / 12 = 600 * 1e-6 * 1.5 / 12 = 7.5e-5 m,
@@ -158,8 +158,8 @@ def test_angle_interpolation_matches_a_direct_linearisation():
     bending frequency, its damping and |Gamma| (participation of the stroke acceleration)."""
     from dataclasses import replace
 
-    from sim_core.modal_telescopic import L_GRID, N_NODES, linearize_at, reference_rope_lengths
-    from sim_core.telescopic import TelescopicParams
+    from sim_core.systems.telescopic.params import TelescopicParams
+    from sim_core.systems.telescopic.modal import L_GRID, N_NODES, linearize_at, reference_rope_lengths
     r = load_raw()
     A = r["angles"]
     if len(A) < 3:

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from sim_core.folding import FoldingParams, build_folding
+from sim_core.systems.folding.build import FoldingParams, build_folding
 
 
 @pytest.fixture(scope="module")

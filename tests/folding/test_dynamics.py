@@ -8,10 +8,13 @@ Runtimes on the shared 2-core machine: ~1 min per run; the full 45 s scene is @s
 import numpy as np
 import pytest
 
-from sim_core.folding import (PLANE_BASIS, SLEW_AXIS, FoldingParams, angular_momentum,
-                              build_folding, folding_result, simulate_folding)
-from sim_core.rigid_body import rot_axis
-from sim_core.simulate import integrate
+from sim_core.integrate.driver import integrate
+from sim_core.systems.folding.build import (
+    FoldingParams,
+    build_folding,
+    folding_result,
+    simulate_folding,
+)
 
 # ---------------------------------------------------------------------------------------------
 # rigid-limit kinematics: booms E x 1000, cylinders as exact (massless, rigid) length drivers
@@ -43,7 +46,7 @@ def _circle_intersection(F, rF, G, rG, side):
 
 def closed_form_tip(s1, s2, phi, L=12.0):
     """Boom-2 tip of the rigid linkage (SCENARIOS B geometry) for pin distances s1, s2 (m) and
-    slew angle phi (rad) -- written independently of sim_core.folding.linkage_points."""
+    slew angle phi (rad) -- written independently of sim_core.systems.folding.build.linkage_points."""
     A, base = np.array([0.0, 2.0]), np.array([0.5, 0.6])
     rho, delta = np.hypot(3.0, 0.35), np.arctan2(-0.35, 3.0)
     Db = A - base
@@ -140,7 +143,7 @@ def _free_slew_run(rtol, n_nodes=3):
     Q, Qd = m.full_state(0.0, z0, zd_g)
     M, _ = m.mass_force(0.0, Q, Qd)
     Mr = m.P.T @ M @ m.P
-    from sim_core.constraints import constraint_terms
+    from sim_core.physics.constraints import constraint_terms
     C = constraint_terms(m.nonlinear, 0.0, Q, Qd)[1] @ m.P
     Minv_Ct = np.linalg.solve(Mr, C.T)
     zd0 = zd_g - Minv_Ct @ np.linalg.solve(C @ Minv_Ct, C @ zd_g)

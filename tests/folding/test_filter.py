@@ -18,7 +18,7 @@ machine (2768 and 5840 RHS) -> @slow.
 import numpy as np
 import pytest
 
-from sim_core.folding import FoldingParams, simulate_folding
+from sim_core.systems.folding.build import FoldingParams, simulate_folding
 
 T_END = 0.6
 N_OUT = 601          # 1 kHz sampling (Nyquist 500 Hz)

@@ -1,5 +1,5 @@
 """Jacobians of the rigid-body terms and new constraints against complex step / finite
-differences (sim_core.rigid_body, sim_core.folding.BoomRest).
+differences (sim_core.physics.rigid_body, sim_core.systems.folding.build.BoomRest).
 
 Complex step (h = 1e-20) is exact to round-off, so analytic Jacobians must agree to ~1e-12
 relative; the Lagrange-equation check of the quadratic velocity forces uses central differences
@@ -10,8 +10,8 @@ is ~1e-7 relative, we allow 1e-6.  Runtime ~5 s.
 import numpy as np
 import pytest
 
-from sim_core.folding import BoomRest
-from sim_core.rigid_body import RigidBody, SpringDamperActuator
+from sim_core.physics.rigid_body import RigidBody, SpringDamperActuator
+from sim_core.systems.folding.build import BoomRest
 
 H = 1e-20
 

@@ -6,10 +6,9 @@ import json
 import numpy as np
 import pytest
 
+from sim_core import load_scene, simulate
 from sim_core.cli import main
 from sim_core.result import Result
-from sim_core.scene import load_scene
-from sim_core.simulate import simulate
 
 
 def test_cli_run_writes_result_and_figures(tmp_path):

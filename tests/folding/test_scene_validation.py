@@ -2,8 +2,8 @@
 
 import pytest
 
+from sim_core import load_scene
 from sim_core.errors import SceneError
-from sim_core.scene import load_scene
 
 CASES = [
     ({"solver.t_end": 0}, "solver.t_end = 0: out of range, allowed (0, inf)"),

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from sim_core.errors import SimulationError
-from sim_core.integrators import (
+from sim_core.integrate import (
     GeneralizedAlphaParameters,
     IntegrationResult,
     SecondOrderSystem,

@@ -1,4 +1,4 @@
-"""Index-1 (M = I) wrapper of a nonlinearly constrained model (sim_core.integrators.index1).
+"""Index-1 (M = I) wrapper of a nonlinearly constrained model (sim_core.integrate.index1).
 
 Generalized-alpha on the Baumgarte-stabilized ODE z_ddot = a(t, z, z_dot) of the nearly rigid
 telescopic case 9.1 (Zhao-Qi-Wang 2024 Sec. 9.1) against explicit RK45 on model.rhs.
@@ -7,10 +7,11 @@ telescopic case 9.1 (Zhao-Qi-Wang 2024 Sec. 9.1) against explicit RK45 on model.
 import numpy as np
 import pytest
 
-from sim_core.integrators import integrate_generalized_alpha
-from sim_core.integrators.index1 import Index1System
-from sim_core.simulate import integrate
-from sim_core.telescopic import TelescopicParams, build_telescopic, initial_equilibrium
+from sim_core.integrate import integrate_generalized_alpha
+from sim_core.integrate.driver import integrate
+from sim_core.integrate.index1 import Index1System
+from sim_core.systems.telescopic.params import TelescopicParams
+from sim_core.systems.telescopic.build import build_telescopic, initial_equilibrium
 
 
 def test_wrapper_is_identity_mass_and_model_accelerations():

@@ -1,9 +1,9 @@
-"""The statistics of ``sim_core.simulate.integrate``: the minimum step is the dynamics', not
+"""The statistics of ``sim_core.integrate.driver.integrate``: the minimum step is the dynamics', not
 the length of the last step that the solver cuts to land on t_end."""
 
 import numpy as np
 
-from sim_core.simulate import integrate
+from sim_core.integrate.driver import integrate
 
 
 class Oscillator:

@@ -11,9 +11,11 @@
 import numpy as np
 import pytest
 
-from sim_core.simulate import RefreshedJacobian, _CountingRHS, integrate
-from sim_core.state_jacobian import state_jacobian
-from sim_core.telescopic import TelescopicParams, build_telescopic, initial_equilibrium
+from sim_core.integrate.bdf import RefreshedJacobian
+from sim_core.integrate.driver import _CountingRHS, integrate
+from sim_core.model.state_jacobian import state_jacobian
+from sim_core.systems.telescopic.params import TelescopicParams
+from sim_core.systems.telescopic.build import build_telescopic, initial_equilibrium
 
 
 @pytest.fixture(scope="module")

@@ -22,13 +22,11 @@ import time
 import numpy as np
 import pytest
 
-from sim_core import load_scene
-from sim_core.errors import (ElementEvaluationError, SimulationError, StalledIntegration,
-                             SuspectResult)
+from sim_core import load_scene, simulate
+from sim_core.errors import ElementEvaluationError, SimulationError, StalledIntegration, SuspectResult
+from sim_core.integrate.checks import ENERGY_FAIL, ENERGY_SUSPECT, check_result, result_checks
 from sim_core.result import Result
-from sim_core.scene import validate
-from sim_core.simulate import (ENERGY_FAIL, ENERGY_SUSPECT, check_result, result_checks,
-                               simulate)
+from sim_core.systems.beam.schema import validate
 from sim_core.validation.closed_form import cantilever_beta_L
 
 EI, EA, RHOA, L, E_MOD, G = 7.22e8, 8.53e9, 318.86, 10.0, 2.1e11, 9.81
@@ -124,7 +122,7 @@ def test_run_at_rest_is_judged_against_its_stored_energy():
     energy (33.9 J): the balance is judged against STORED_FLOOR of the stored energy, not
     against that round-off-sized exchange (which would read as a drift of order 1: measured
     0.5 before the floor), and the run is not suspect."""
-    from sim_core.simulate import STORED_FLOOR
+    from sim_core.integrate.checks import STORED_FLOOR
     sc = cantilever(3, rtol=1e-3, t_end=0.3)
     sc["initial"]["static_equilibrium"] = True
     res = simulate(sc)
@@ -171,8 +169,8 @@ def test_element_failure_is_a_typed_error_at_its_time():
     """An element batch that divides by zero (all coordinates zero: a collapsed element) is an
     ElementEvaluationError at the request's time, on the worker thread and on the calling
     thread alike."""
-    from sim_core.assemble import build_model
-    from sim_core.beam import element_worker
+    from sim_core.model import workers as element_worker
+    from sim_core.systems.beam.build import build_model
     for how in ("on", "off"):
         m, Q0, Qd0 = build_model(cantilever(3))
         m._governor = element_worker.Governor(cores=2, how=how)
@@ -256,9 +254,11 @@ def test_telescopic_energy_check_sees_energy_from_nowhere(monkeypatch):
     their states): a healthy run (scene 9.2 at 2 sub-elements, 0.3 s of a 0.5 s ramp: friction
     and the filter only take energy out) passes; the same states judged without the drive's
     work -- energy that appears from nowhere, ~half the exchanged energy -- fail grossly."""
-    from sim_core import energy_audit
-    from sim_core.simulate import integrate, telescopic_energy_check
-    from sim_core.telescopic import TelescopicParams, build_telescopic, initial_equilibrium
+    from sim_core.integrate.driver import integrate
+    from sim_core.systems.telescopic import energy_audit
+    from sim_core.systems.telescopic.params import TelescopicParams
+    from sim_core.systems.telescopic.build import build_telescopic, initial_equilibrium
+    from sim_core.systems.telescopic.energy_audit import telescopic_energy_check
     p = TelescopicParams(n_nodes=3, E=2.1e11, payload=25000.0, luffing_angle_deg=60.0,
                          stroke0=2.0, t_ramp=0.5, t_hold_end=0.6, friction=True)
     ts = build_telescopic(p)

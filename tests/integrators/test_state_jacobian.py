@@ -1,4 +1,4 @@
-"""Structured Jacobian of the state equations (sim_core.state_jacobian) against differences of
+"""Structured Jacobian of the state equations (sim_core.model.state_jacobian) against differences of
 the whole right-hand side, and BDF with it converging with the tolerance.
 
 Tolerance of the Jacobian checks.  Both sides are central differences (the structured one of
@@ -16,10 +16,11 @@ import numpy as np
 import pytest
 
 from sim_core import load_scene
-from sim_core.assemble import build_model
-from sim_core.simulate import integrate
-from sim_core.state_jacobian import state_jacobian
-from sim_core.telescopic import TelescopicParams, build_telescopic, initial_equilibrium
+from sim_core.integrate.driver import integrate
+from sim_core.model.state_jacobian import state_jacobian
+from sim_core.systems.beam.build import build_model
+from sim_core.systems.telescopic.params import TelescopicParams
+from sim_core.systems.telescopic.build import build_telescopic, initial_equilibrium
 
 
 def _reference_columns(model, t, y, cols, h_rel):
@@ -152,7 +153,8 @@ def test_bdf_with_structured_jacobian_converges_with_the_tolerance():
 
 
 def test_unknown_jacobian_is_rejected():
-    from sim_core.scene import SceneError, solver_table
+    from sim_core.errors import SceneError
+    from sim_core.scene.fields import solver_table
     with pytest.raises(SceneError, match="solver.jacobian"):
         solver_table({"t_end": 1.0, "jacobian": "analytic"})
 
@@ -161,7 +163,7 @@ def test_folding_jacobian_without_point_dependencies():
     """The folding manipulator's rigid-body points and spring-damper cylinders do not say which
     coordinates they depend on: those pieces are differenced in every coordinate (the general
     path) - same check, on a random subset of columns."""
-    from sim_core.folding import FoldingParams, build_folding
+    from sim_core.systems.folding.build import FoldingParams, build_folding
     fs = build_folding(FoldingParams(n_nodes=3))
     m = fs.model
     assert any(c.points is None for c in m.nonlinear)

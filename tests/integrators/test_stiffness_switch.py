@@ -1,4 +1,4 @@
-"""RK45 -> BDF stiffness switch of ``sim_core.simulate.integrate`` (solver.method = "auto").
+"""RK45 -> BDF stiffness switch of ``sim_core.integrate.driver.integrate`` (solver.method = "auto").
 
 The detector is Hairer's DOPRI5 test (Hairer, Nørsett, Wanner, Solving ODEs I, Sec. II.10):
 for a linear right-hand side f = λ y the two c = 1 stages give ρ = |λ| exactly, so h ρ is
@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 from scipy.integrate import RK45
 
-from sim_core.simulate import StiffnessDetector, integrate
+from sim_core.integrate.driver import integrate
+from sim_core.integrate.switching import StiffnessDetector
 
 
 class Linear:
@@ -130,7 +131,7 @@ def test_switches_back_to_rk45_after_the_stiff_interval():
 def test_spectral_radius_estimate():
     """Power-iteration estimate against the eigenvalues: a dominant real eigenvalue, and a
     dominant complex pair (damped oscillator, the shape of a filtered beam mode)."""
-    from sim_core.simulate import spectral_radius
+    from sim_core.integrate.switching import spectral_radius
     rng = np.random.default_rng(3)
     V = rng.normal(size=(6, 6))
     A = V @ np.diag([-4.0e4, -300.0, -20.0, -1.0, -0.5, 0.1]) @ np.linalg.inv(V)
@@ -149,7 +150,8 @@ def test_bdf_newton_limit_is_raised_only_inside_bdf_steps():
     own BDF steps only: the right-hand side sees the raised limit during BDF steps, scipy's
     own value before and after the run."""
     import scipy.integrate._ivp.bdf as bdf_module
-    from sim_core.simulate import BDF_NEWTON_ITERATIONS
+
+    from sim_core.integrate.bdf import BDF_NEWTON_ITERATIONS
 
     before = bdf_module.NEWTON_MAXITER
     seen = []
@@ -175,7 +177,7 @@ def test_second_order_newton_lu_equals_the_whole_lu():
     structure takes the whole LU."""
     from scipy.integrate import BDF
 
-    from sim_core.simulate import SecondOrderNewtonLU
+    from sim_core.integrate.bdf import SecondOrderNewtonLU
 
     rng = np.random.default_rng(5)
     n = 6

@@ -187,9 +187,8 @@ def test_plot_out_puts_figures_elsewhere(run_dir, tmp_path, capsys):
 # -- failed solve: status 3, one line, partial result kept -----------------------------------
 
 def _fail(monkeypatch, partial: Result | None = None):
-    # ``sim_core.simulate`` as an attribute is the function (re-exported by sim_core/__init__),
-    # so the module is taken from sys.modules
-    simulate_mod = sys.modules["sim_core.simulate"]
+    # the command line calls sim_core.api.simulate through its own name
+    simulate_mod = sys.modules["sim_core.cli"]
 
     def failing(scene, progress=None):
         exc = SimulationError(0.0125, "non-finite accelerations", step=1e-6,
@@ -239,7 +238,8 @@ def test_failed_solve_in_a_real_process_exits_3_without_traceback(tmp_path):
     """The same through the interpreter's exit status (the failure is injected)."""
     code = (
         "import sys, sim_core\n"
-        "m = sys.modules['sim_core.simulate']\n"
+        "import sim_core.cli\n"
+        "m = sys.modules['sim_core.cli']\n"
         "from sim_core.errors import SimulationError\n"
         "def f(scene, progress=None):\n"
         "    raise SimulationError(0.5, 'RK45 failed: step size too small', step=1e-12)\n"
@@ -256,7 +256,7 @@ def test_run_without_matplotlib_keeps_results_and_skips_figures(monkeypatch, cap
     t = np.linspace(0.0, 0.05, 3)
     stats = {"wall_time_s": 0.1, "n_steps": 3, "n_rhs": 20, "min_step_s": 0.01,
              "max_step_s": 0.02, "real_time_factor": 0.5}
-    monkeypatch.setattr(sys.modules["sim_core.simulate"], "simulate",
+    monkeypatch.setattr(sys.modules["sim_core.cli"], "simulate",
                         lambda scene, progress=None: Result(t, {"tip_position": np.zeros((3, 3))},
                                                             dict(stats), scene))
     monkeypatch.setitem(sys.modules, "matplotlib", None)          # import matplotlib fails

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from sim_core import SimulationError, load_scene, simulate
-from sim_core.model import Model
+from sim_core.model.model import Model
 
 
 def _short_sleeve_scene() -> dict:

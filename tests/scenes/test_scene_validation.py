@@ -10,8 +10,10 @@ import math
 
 import pytest
 
+from sim_core import load_scene
 from sim_core.errors import SceneError
-from sim_core.scene import apply_overrides, load_scene, parse_value, shipped_scenes, validate
+from sim_core.scene.io import apply_overrides, parse_value, shipped_scenes
+from sim_core.systems.beam.schema import validate
 
 SCENE = "beam_through_sleeve"
 
@@ -228,7 +230,7 @@ def test_unknown_method_suggests():
 
 @pytest.mark.parametrize("scene", ["beam_through_sleeve", "telescopic_extraction", "folding_boom"])
 def test_one_solver_table_for_every_scene_kind(scene):
-    """The [solver] table is validated by one function (sim_core.scene.solver_table) for all
+    """The [solver] table is validated by one function (sim_core.scene.fields.solver_table) for all
     scene kinds: the same methods are accepted, the same errors name the field and range."""
     for method in ("RK45", "BDF", "auto"):
         assert load_scene(scene, overrides={"solver.method": method})["solver"]["method"] == method

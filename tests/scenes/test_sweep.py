@@ -22,8 +22,17 @@ import pytest
 from sim_core import cli
 from sim_core.errors import SceneError
 from sim_core.result import Result
-from sim_core.sweep import (SweepError, case_name, completed_case, grid_cases, parse_grid,
-                            rigid_tip_deviation, run_sweep, scalar_outcomes, split_values)
+from sim_core.sweep import (
+    SweepError,
+    case_name,
+    completed_case,
+    grid_cases,
+    parse_grid,
+    rigid_tip_deviation,
+    run_sweep,
+    scalar_outcomes,
+    split_values,
+)
 
 ROOT = Path(__file__).resolve().parents[2]
 RL = "telescopic_extraction_rl"

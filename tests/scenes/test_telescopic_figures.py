@@ -40,7 +40,8 @@ def test_rigid_limit_panel_shows_the_deflection(tmp_path, monkeypatch):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from sim_core import plots
+
+    from sim_core.systems.telescopic import plots
 
     figs = []
     orig = plots.save_figure

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from sim_core import SceneError, load_scene
-from sim_core.scene import shipped_scenes
-from sim_core.telescopic_scene import params_from_scene
+from sim_core.scene.io import shipped_scenes
+from sim_core.systems.telescopic.schema import params_from_scene
 
 SCENE = "telescopic_extraction"
 

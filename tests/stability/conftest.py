@@ -6,7 +6,7 @@ numerically stable").
   statics (friction, slider springs, gap, smoothing interval and the stress filter do not act at
   rest: friction law mu(0) = 0, the filter forces are rate terms).
 * ``run_window`` integrates the full model with sim_core's own RK45 driver
-  (``sim_core.simulate.integrate``: the integrator statistics, including the minimum
+  (``sim_core.integrate.driver.integrate``: the integrator statistics, including the minimum
   accepted step ``min_step_s``) and returns the public Result plus the total mechanical energy
   and the telescopic-cylinder work at the output times.
 """
@@ -16,11 +16,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sim_core.energy_audit import AuditedSystem
-from sim_core.energy_audit import mechanical_energy as _mechanical_energy
-from sim_core.simulate import integrate, run_with_partial
-from sim_core.telescopic import (TelescopicParams, _telescopic_result, build_telescopic,
-                                 initial_equilibrium)
+from sim_core.integrate.driver import integrate, run_with_partial
+from sim_core.systems.telescopic.params import TelescopicParams
+from sim_core.systems.telescopic.build import _telescopic_result, build_telescopic, initial_equilibrium
+from sim_core.systems.telescopic.energy_audit import AuditedSystem
+from sim_core.systems.telescopic.energy_audit import mechanical_energy as _mechanical_energy
 
 _EQ_KEYS = ("n_booms", "boom_length", "luffing_angle_deg", "stroke0", "L_h", "E", "rho",
             "payload", "rope_EA", "gravity", "n_nodes", "n_gauss", "torsion", "rope_elasticity",
@@ -70,7 +70,7 @@ def build_undeformed(p: TelescopicParams, target=None):
 
 def mechanical_energy(ts, t: float, y: np.ndarray) -> float:
     """Kinetic + strain + gravity energy of the booms, payload point mass and rope strain (J)
-    (sim_core.energy_audit.mechanical_energy).  The stress filter's rate terms are not included:
+    (sim_core.systems.telescopic.energy_audit.mechanical_energy).  The stress filter's rate terms are not included:
     with the filter on, a run from rest has E(t) - E(0) <= W (the filter's inertia-like term is
     >= 0 and its damping term dissipates)."""
     n = ts.model.n_dof
@@ -88,7 +88,7 @@ def run_window(ts, y0, t_end: float, n_output: int = 21, rtol: float = 1e-6, ato
     the telescopic contract).  With ``energy``: also outputs ``energy`` (J, mechanical energy
     incl. payload and ropes) and ``cylinder_work`` (J, the work of the telescopic cylinder, its
     multiplier times the prescribed rate, integrated as an extra state of the same RK45 run:
-    sim_core.energy_audit; with this model's sign convention the multiplier is the pushing
+    sim_core.systems.telescopic.energy_audit; with this model's sign convention the multiplier is the pushing
     force, positive in an extraction against gravity).  A SimulationError propagates with its
     partial result attached.  With ``step_floor``: raises StepCollapse at the first accepted
     step shorter than the floor (the final step, cut to land on t_end, excepted)."""

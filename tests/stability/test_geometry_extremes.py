@@ -1,7 +1,7 @@
 """Hard cases 2 and 3: contact points passing each other, the overlap transition, and driving to
 the end stops of the valid stroke range (0 < L_s < boom length).
 
-Geometry (sim_core.telescopic): boom 2 is two spline elements split at its outer contact node
+Geometry (sim_core.systems.telescopic.build): boom 2 is two spline elements split at its outer contact node
 s_3,2 = L - L_s; its inner contact point s_2,2 = L_s (boom 3's left end) is interpolated.  At
 L_s = L/2 = 5 m the two contact points pass each other (s_2,2 moves from one element into the
 other) and boom 3's left end passes boom 1's right end (overlap transition).  Near full
@@ -17,7 +17,7 @@ so the explicit step, and it only dissipates: from rest E(t) - E(0) <= W_cylinde
 import numpy as np
 import pytest
 
-from sim_core.telescopic import TelescopicParams
+from sim_core.systems.telescopic.params import TelescopicParams
 
 from .conftest import assert_no_energy_created, assert_stable, build_at_equilibrium, run_window
 from .thresholds import MIN_ELEMENT_LENGTH, MIN_STEP_FRICTIONLESS, constraint_tol

@@ -8,7 +8,7 @@ about D1 needs a cylinder force of ~M / 0.23 m, which compresses and bends boom 
 D3; the boom rotates down, and the rotation shortens the lever further.  Below some stiffness
 this softening wins: the equilibrium path in the load factor (weight x lambda) turns back at a
 limit point.  The statics trace the path by pseudo-arclength continuation
-(sim_core.statics.load_continuation) and raise the typed NoStaticEquilibrium there.
+(sim_core.model.statics.load_continuation) and raise the typed NoStaticEquilibrium there.
 
 Facts checked: the limit point lies below the full weight (soft booms), the error names the
 angle and the cylinder lever, and the limit load is proportional to E (the elastic forces are
@@ -20,7 +20,8 @@ import numpy as np
 import pytest
 
 from sim_core.errors import NoStaticEquilibrium, SimulationError
-from sim_core.telescopic import TelescopicParams, build_telescopic, initial_equilibrium
+from sim_core.systems.telescopic.params import TelescopicParams
+from sim_core.systems.telescopic.build import build_telescopic, initial_equilibrium
 
 
 def _limit(E: float, n_nodes: int, payload: float = 0.0) -> NoStaticEquilibrium:

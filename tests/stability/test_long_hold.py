@@ -1,18 +1,23 @@
 """Hard case 7: a long hold at rest - energy and constraint violation stay bounded (no drift).
 
 Default run: 120 s hold after the paper's extraction on the fast model (the modal ROM of
-sim_core.modal_telescopic, the env's dynamics), and a 1 s hold of the full flexible model at its
+sim_core.systems.telescopic.modal, the env's dynamics), and a 1 s hold of the full flexible model at its
 static equilibrium.  Slow: 120 s hold of the full flexible model."""
 
 import numpy as np
 import pytest
 
-from sim_core.modal_telescopic import ModalROM, tables_for
-from sim_core.telescopic import TelescopicParams
+from sim_core.systems.telescopic.params import TelescopicParams
+from sim_core.systems.telescopic.modal import ModalROM, tables_for
 
 from .conftest import assert_stable, build_at_equilibrium, energy_tol, run_window
-from .thresholds import (CONSTRAINT_TOL, HOLD_DECAY_FRACTION, HOLD_TIP_DRIFT,
-                         MIN_STEP_FRICTIONLESS, ROM_ENERGY_GROWTH)
+from .thresholds import (
+    CONSTRAINT_TOL,
+    HOLD_DECAY_FRACTION,
+    HOLD_TIP_DRIFT,
+    MIN_STEP_FRICTIONLESS,
+    ROM_ENERGY_GROWTH,
+)
 
 
 def _rom_energy(rom):

@@ -1,7 +1,7 @@
 """Hard case 5: stiff and soft material (E = 2.1e12 and 2.1e10 Pa), payload 0 and 25 t, luffing
 angle 0 to 80 degrees.
 
-Default run: the rigid limit (sim_core.rigid_telescopic, elastic rope dof) over the whole grid
+Default run: the rigid limit (sim_core.systems.telescopic.rigid, elastic rope dof) over the whole grid
 with its energy balance, and the two opposite corners of the flexible model (stiff / unloaded /
 horizontal and soft / 25 t / 80 deg; their equilibria are shared with
 test_geometry_extremes.py) on the start of the paper's schedule made fast (0.1 s ramp).
@@ -14,13 +14,12 @@ import numpy as np
 import pytest
 
 from sim_core.errors import NoStaticEquilibrium
-from sim_core.rigid_telescopic import RigidTelescopic
-from sim_core.telescopic import TelescopicParams
+from sim_core.systems.telescopic.params import TelescopicParams
+from sim_core.systems.telescopic.rigid import RigidTelescopic
 from sim_core.validation.closed_form import luffing_geometry
 
 from .conftest import assert_stable, build_at_equilibrium, run_window
-from .test_geometry_extremes import (SOFT_CROSSING, STIFF_EXTENSION,
-                                     energy_balanced)
+from .test_geometry_extremes import SOFT_CROSSING, STIFF_EXTENSION, energy_balanced
 from .thresholds import CONSTRAINT_TOL, ENERGY_REL_TOL, MIN_STEP_FRICTIONLESS
 
 GRID = list(itertools.product((2.1e12, 2.1e10), (0.0, 25000.0), (0.0, 80.0)))

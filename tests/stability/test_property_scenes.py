@@ -1,5 +1,5 @@
 """Hard case 8: property-based scenes drawn inside the valid ranges of the scene schema
-(sim_core.telescopic_scene).  Every run either completes with finite outputs or raises the typed
+(sim_core.systems.telescopic.schema).  Every run either completes with finite outputs or raises the typed
 sim_core.errors.SimulationError (with a partial result) - never another exception, never a NaN,
 and with a bounded number of integrator steps (no hang).
 

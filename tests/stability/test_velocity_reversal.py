@@ -15,7 +15,7 @@ import math
 import numpy as np
 import pytest
 
-from sim_core.telescopic import TelescopicParams
+from sim_core.systems.telescopic.params import TelescopicParams
 
 from .conftest import assert_no_energy_created, assert_stable, build_at_equilibrium, run_window
 from .thresholds import CONSTRAINT_TOL, MIN_STEP_FRICTION

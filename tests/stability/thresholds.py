@@ -54,7 +54,7 @@ def constraint_tol(extent_m: float, rtol: float = 1e-6, atol: float = 1e-7) -> f
 # frictionless; Baumgarte forces do O(violation * lambda) ~ 1e-6 m * 1e5 N = 0.1 J of work).
 # Error budget: RK45 at rtol 1e-6 keeps the state's relative error ~1e-6 per step, i.e. an
 # energy error ~1e-6 of the energy exchanged per step, accumulated over <= ~100 steps: 1e-4;
-# the cylinder work is integrated as an extra state of the same run (sim_core.energy_audit;
+# the cylinder work is integrated as an extra state of the same run (sim_core.systems.telescopic.energy_audit;
 # a trapezoidal sum on the 25 ms output grid was off by ~250 J during the 0.1 s drive ramps).
 # Tolerance: 1e-3 of the energy scale (range of the mechanical energy over the run, plus
 # |work|), ten times the budget.

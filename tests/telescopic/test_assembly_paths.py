@@ -1,10 +1,10 @@
 """The fast assembly and solve paths of the telescopic right-hand side against their references.
 
 * reduced assembly (element and point-effect blocks scattered straight into P^T M P,
-  ``sim_core.assembly_compiled``) against forming the full M and projecting it;
+  ``sim_core.model._assembly_numba``) against forming the full M and projecting it;
 * the compiled scatter against its numpy version;
-* the saddle-point solve by block elimination over the beams (``constraints._kkt_factor_blocks``
-  and its compiled version ``sim_core.saddle_point_compiled``) against the LU of the whole
+* the saddle-point solve by block elimination over the beams (``saddle_point.kkt_factor_blocks_reference``
+  and its compiled version ``sim_core.model._saddle_point_numba``) against the LU of the whole
   matrix, with and without the refinement step;
 * the material point's real evaluation served from the real part of a complex-step one against
   a fresh real evaluation;
@@ -16,10 +16,13 @@
 import numpy as np
 import pytest
 
-from sim_core import assembly_compiled, saddle_point_compiled
-from sim_core.constraints import _kkt_factor_blocks, constraint_terms, kkt_factor, material_point
-from sim_core.point_effects import PointMass
-from sim_core.telescopic import TelescopicParams, build_telescopic, initial_equilibrium
+from sim_core.model import _assembly_numba as assembly_compiled
+from sim_core.model import _saddle_point_numba as saddle_point_compiled
+from sim_core.model.saddle_point import kkt_factor, kkt_factor_blocks_reference
+from sim_core.physics.constraints import constraint_terms, material_point
+from sim_core.physics.point_effects import PointMass
+from sim_core.systems.telescopic.params import TelescopicParams
+from sim_core.systems.telescopic.build import build_telescopic, initial_equilibrium
 
 
 @pytest.fixture(scope="module")
@@ -36,7 +39,7 @@ def state():
 def _dense_reference(m, t, z, zd):
     Q, Qd = m.full_state(t, z, zd)
     M, F = m.mass_force(t, Q, Qd)
-    Qdd_p = m.A_pinv @ m._b(t, 2)
+    Qdd_p = m.A_pinv @ m.linear_targets(t, 2)
     return m.P.T @ M @ m.P, m.P.T @ (F - M @ Qdd_p)
 
 
@@ -66,7 +69,7 @@ def test_compiled_scatter_equals_numpy(state, monkeypatch):
 
 def _saddle(m, z, zd, t=0.3):
     Q, Qd = m.full_state(t, z, zd)
-    Mr, Fr, blocks = m._reduced_mass_force_at(t, Q, Qd, m.A_pinv @ m._b(t, 2), blocks=True)
+    Mr, Fr, blocks = m._reduced_mass_force_at(t, Q, Qd, m.A_pinv @ m.linear_targets(t, 2), blocks=True)
     _, J, _, c = constraint_terms(m.nonlinear, t, Q, Qd)
     C = J @ m.P
     K = np.block([[Mr, C.T], [C, np.zeros((C.shape[0], C.shape[0]))]])
@@ -90,14 +93,14 @@ def test_compiled_elimination_needs_no_refinement_at_the_paper_discretisation():
     with the LU's to 1e-9 of their size.  Measured: residuals 4.9e-16 (LU), 6.5e-16
     (compiled), 2.8e-14 (numpy)."""
     from sim_core import load_scene
-    from sim_core.telescopic_scene import params_from_scene
+    from sim_core.systems.telescopic.schema import params_from_scene
     ts = build_telescopic(params_from_scene(load_scene("telescopic_extraction")))
     m = ts.model
     assert not m.kkt_refine
     z, _ = initial_equilibrium(ts)
     Mr, Fr, C, c, blocks, K = _saddle(m, z, np.zeros_like(z), t=0.0)
     r_lu = _residual(K, Fr, c, kkt_factor(Mr, C)(Fr, c))
-    assert _residual(K, Fr, c, _kkt_factor_blocks(Mr, C, blocks, refine=False)(Fr, c)) > 10.0 * r_lu
+    assert _residual(K, Fr, c, kkt_factor_blocks_reference(Mr, C, blocks, refine=False)(Fr, c)) > 10.0 * r_lu
     raw = saddle_point_compiled.kkt_factor_blocks(Mr, C, blocks, refine=False)
     assert _residual(K, Fr, c, raw(Fr, c)) <= 10.0 * r_lu
     Q, _ = m.full_state(0.0, z, np.zeros_like(z))
@@ -141,11 +144,11 @@ def test_block_elimination_matches_the_whole_lu(state):
     np.testing.assert_allclose(L1, L0, rtol=0, atol=1e-9 * np.max(np.abs(L0)))
     # without the refinement step the residual is not at the LU's level (the blocks' condition,
     # ~1e8 and more with the filter mass, enters the Schur complement): the step is needed
-    unrefined = _kkt_factor_blocks(Mr, C, blocks, refine=False)
+    unrefined = kkt_factor_blocks_reference(Mr, C, blocks, refine=False)
     assert _residual(K, Fr, c, unrefined(Fr, c)) >= r_blk
     # the numpy elimination (the reference of the compiled one kkt_factor takes) and the
     # compiled one agree, refined and not
-    ref = _kkt_factor_blocks(Mr, C, blocks)
+    ref = kkt_factor_blocks_reference(Mr, C, blocks)
     assert _residual(K, Fr, c, ref(Fr, c)) <= 10.0 * r_lu + 1e-14
     if saddle_point_compiled.AVAILABLE:
         comp = saddle_point_compiled.kkt_factor_blocks(Mr, C, blocks)
@@ -173,7 +176,7 @@ def test_block_elimination_falls_back_where_a_block_is_not_definite(state):
     Mr0 = Mr.copy()
     b = blocks[0]
     Mr0[np.ix_(b, b)] *= -1.0
-    assert _kkt_factor_blocks(Mr0, C, blocks) is None
+    assert kkt_factor_blocks_reference(Mr0, C, blocks) is None
     if saddle_point_compiled.AVAILABLE:
         assert saddle_point_compiled.kkt_factor_blocks(Mr0, C, blocks) is None
     sol = kkt_factor(Mr0, C, blocks)(Fr, c)
@@ -221,7 +224,7 @@ def test_element_batch_equals_the_elements_one_by_one(state):
     """The compiled batch (element_compiled.ElementBatch, one call for all elements) gives each
     element's kernel result (bitwise); on the worker thread or the calling thread the
     right-hand side is the same."""
-    from sim_core.beam import element_compiled
+    from sim_core.physics import _effects_numba as element_compiled
     if not element_compiled.AVAILABLE:
         pytest.skip("numba not installed")
     ts, z, zd = state
@@ -256,7 +259,7 @@ def test_element_batch_non_finite_raises_in_the_callers_error_state(state):
     """numpy's error state is per thread: the batch's finite check runs on the calling thread,
     so a non-finite element raises FloatingPointError where the caller asked numpy to raise
     (the integrator's right-hand side), as the one-by-one path does."""
-    from sim_core.beam import element_compiled
+    from sim_core.physics import _effects_numba as element_compiled
     if not element_compiled.AVAILABLE:
         pytest.skip("numba not installed")
     ts, z, zd = state
@@ -298,8 +301,8 @@ def test_jacobian_element_batch_equals_the_one_by_one_columns(state):
     equal the element-by-element differences: the same kernel at the same steps, up to the
     round-off of forward differences (eps / rel_step ~ 1e-8 of the column scale; the compiled
     call sequence and the micro-motion warm starts differ in the last bits)."""
-    from sim_core.beam import element_compiled
-    from sim_core.state_jacobian import state_jacobian
+    from sim_core.model.state_jacobian import state_jacobian
+    from sim_core.physics import _effects_numba as element_compiled
     if not element_compiled.AVAILABLE:
         pytest.skip("numba not installed")
     ts, z, zd = state
@@ -363,8 +366,8 @@ def test_point_in_one_compiled_call_equals_the_reference(state, kind, monkeypatc
     """A material point's kinematics, rigid offset and full-length Jacobians in one compiled
     call (point_compiled.point_full) against the compiled kinematics with the rest in numpy,
     for a real and a complex-step state (two point functions, each with its own cache)."""
-    from sim_core import constraints
-    from sim_core.beam import point_compiled
+    from sim_core.physics import constraints
+    from sim_core.physics.beam import _moving_node_beam_numba as point_compiled
     if not point_compiled.AVAILABLE:
         pytest.skip("numba not installed")
     ts, z, zd = state
@@ -416,7 +419,7 @@ def test_a_point_mass_across_two_elements_takes_the_whole_matrix(state):
 
     t = 0.3
     Q, Qd = m.full_state(t, z, zd)
-    Qdd_p = m.A_pinv @ m._b(t, 2)
+    Qdd_p = m.A_pinv @ m.linear_targets(t, 2)
     for idx, whole in (([a, b], True), ([a, shared], False)):
         m.point_effects.append(Lumped(idx))
         try:
@@ -432,7 +435,7 @@ def test_compiled_point_effects_equal_their_local_blocks(state):
     the same formulas on the same point kinematics, equal to round-off (the fixture's
     extraction rope is taut, the retraction rope slack); and the right-hand side with and
     without them."""
-    from sim_core.point_effects import CompiledPointEffects, PointMass, RopeDrive
+    from sim_core.physics.point_effects import CompiledPointEffects, PointMass, RopeDrive
     ts, z, zd = state
     m = ts.model
     if not m.point_effects or CompiledPointEffects.build(m.point_effects) is None:
@@ -464,7 +467,7 @@ def test_compiled_point_effects_equal_their_local_blocks(state):
 
 
 def _pipeline_or_skip(m):
-    from sim_core.beam import element_worker
+    from sim_core.model import workers as element_worker
     if not (saddle_point_compiled.PIPELINE and m.element_thread and m.element_spin
             and element_worker.AVAILABLE):
         pytest.skip("no compiled element worker: no pipelined factorisation")
@@ -515,7 +518,7 @@ def test_pipelined_factor_falls_back_where_a_block_is_not_definite(state):
     _pipeline_or_skip(m)
     t = 0.3
     Q, Qd = m.full_state(t, z, zd)
-    Qdd_p = m.A_pinv @ m._b(t, 2)
+    Qdd_p = m.A_pinv @ m.linear_targets(t, 2)
     Mr_ref, Fr_ref, blocks = m._reduced_mass_force_at(t, Q, Qd, Qdd_p, blocks=True)
     elements = m._element_blocks_started(t, Q, Qd)
     Mr, Fr, blocks2, deferred = m._reduced_mass_force_at(t, Q, Qd, Qdd_p, blocks=True,
@@ -557,7 +560,7 @@ def test_pipeline_adds_the_batch_at_once_where_a_point_mass_couples_two_elements
 
     t = 0.3
     Q, Qd = m.full_state(t, z, zd)
-    Qdd_p = m.A_pinv @ m._b(t, 2)
+    Qdd_p = m.A_pinv @ m.linear_targets(t, 2)
     m.point_effects.append(Lumped())
     try:
         Mr0, Fr0, _ = m._reduced_mass_force_at(t, Q, Qd, Qdd_p, blocks=True)
@@ -581,8 +584,8 @@ def test_compiled_point_effect_jacobian_equals_the_python_pieces(state):
     own pieces are checked too, against central differences of their ``local`` terms to
     1e-6 of their scale (dropping the payload's inertia or rate term, or the rope's T'(l),
     fails it)."""
-    from sim_core.point_effects import CompiledPointEffects
-    from sim_core.state_jacobian import _steps, state_jacobian
+    from sim_core.model.state_jacobian import _steps, state_jacobian
+    from sim_core.physics.point_effects import CompiledPointEffects
     ts, z, zd = state
     m = ts.model
     if CompiledPointEffects.build(m.point_effects) is None:
@@ -600,7 +603,7 @@ def test_compiled_point_effect_jacobian_equals_the_python_pieces(state):
     # F - M Qdd (at the model's accelerations, so the payload's inertia term is in): central
     # differences are O(h^2) accurate, the compiled forward ones O(h) ~ 1e-8 of the scale
     Q, Qd = m.full_state(0.3, z, zd)
-    Qdd = m._lift(0.3, m.accelerations(0.3, z, zd), 2)
+    Qdd = m.lift(0.3, m.accelerations(0.3, z, zd), 2)
     dQ, dQd = m._compiled_point_effects().jacobian(Q, Qd, Qdd, lambda x: _steps(x, 1.5e-8))
 
     def pieces(Qx, Qdx):
@@ -629,7 +632,8 @@ def test_shared_elements_are_each_taken_once():
     (model._SharedElements): each element is computed exactly once whoever takes it, and after
     ``stop`` no further one is handed out."""
     import threading
-    from sim_core.model import _SharedElements
+
+    from sim_core.model.workers import SharedElements as _SharedElements
     done, lock = [], threading.Lock()
 
     def work(e):
@@ -655,8 +659,8 @@ def test_particular_lift_and_targets_equal_their_definitions(state):
     nonlinear constraints (the cylinder's prescribed stroke; zeros elsewhere) as each
     constraint's own b(t)."""
     from sim_core import load_scene
-    from sim_core.assemble import build_model
-    from sim_core.constraints import targets
+    from sim_core.physics.constraints import targets
+    from sim_core.systems.beam.build import build_model
     ts, _, _ = state
     sleeve, _, _ = build_model(load_scene("beam_through_sleeve"))
     for m, constant in ((ts.model, True), (sleeve, False)):
@@ -664,7 +668,7 @@ def test_particular_lift_and_targets_equal_their_definitions(state):
         for t in (0.0, 0.7, 3.1):
             for which in range(3):
                 X = m._particular(t, which)
-                np.testing.assert_array_equal(X, m.A_pinv @ m._b(t, which))
+                np.testing.assert_array_equal(X, m.A_pinv @ m.linear_targets(t, which))
                 assert not X.flags.writeable or not constant
         if constant:
             assert m._particular(0.7, 0) is m._particular(3.1, 0)
@@ -684,7 +688,7 @@ def test_frictionless_model_takes_the_block_elimination(monkeypatch):
     worker, as with friction -- not by the dense LU of the whole matrix (kkt_accelerations,
     kept for Model.kkt_blocks False) -- and gives the dense LU's accelerations and multipliers
     (to 1e-9 of their size; measured 1e-13)."""
-    from sim_core import model as model_module
+    from sim_core.model import model as model_module
     ts = build_telescopic(TelescopicParams(n_nodes=3, friction=False, payload=1000.0, E=2.1e12))
     m = ts.model
     assert not m.multiplier_forces

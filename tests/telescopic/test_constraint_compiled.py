@@ -1,5 +1,5 @@
-"""The constraint rows as one compiled program (``sim_core.constraint_compiled``) against the
-Python closures of ``sim_core.constraints`` (the reference), for the rows and for the structured
+"""The constraint rows as one compiled program (``sim_core.physics._constraints_numba``) against the
+Python closures of ``sim_core.physics.constraints`` (the reference), for the rows and for the structured
 Jacobian's constraint columns.
 
 Scenes: the telescopic system with friction and payload (point and angle coincidences with
@@ -10,9 +10,12 @@ the pulleys)."""
 import numpy as np
 import pytest
 
-from sim_core import constraint_compiled, constraints, state_jacobian
-from sim_core.constraints import NonlinearConstraint, constraint_terms, material_point
-from sim_core.telescopic import TelescopicParams, build_telescopic, initial_equilibrium
+from sim_core.model import state_jacobian
+from sim_core.physics import _constraints_numba as constraint_compiled
+from sim_core.physics import constraints
+from sim_core.physics.constraints import NonlinearConstraint, constraint_terms, material_point
+from sim_core.systems.telescopic.params import TelescopicParams
+from sim_core.systems.telescopic.build import build_telescopic, initial_equilibrium
 
 pytestmark = pytest.mark.skipif(not constraint_compiled.AVAILABLE, reason="numba not installed")
 

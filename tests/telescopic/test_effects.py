@@ -6,12 +6,12 @@ import math
 import numpy as np
 import pytest
 
-from sim_core.constraints import material_point
-from sim_core.contact_friction import ContactFriction, section_reaction
-from sim_core.rigid_telescopic import RigidTelescopic
-from sim_core.telescopic import TelescopicParams, build_telescopic, initial_equilibrium
-from sim_core.validation.closed_form import (luffing_geometry, rigid_tip_kinematics,
-                                             static_luffing_forces)
+from sim_core.physics.constraints import material_point
+from sim_core.physics.contact.friction import ContactFriction, section_reaction
+from sim_core.systems.telescopic.params import TelescopicParams
+from sim_core.systems.telescopic.build import build_telescopic, initial_equilibrium
+from sim_core.systems.telescopic.rigid import RigidTelescopic
+from sim_core.validation.closed_form import luffing_geometry, rigid_tip_kinematics, static_luffing_forces
 
 PAPER = dict(E=2.1e11, payload=25000.0)
 THETA = math.radians(60.0)
@@ -147,7 +147,7 @@ def test_friction_off_equals_mu_zero():
     agree to the integrators' global error (both at rtol 1e-8 here: < 1e-9 m on a 0.05 s window
     where the tip moves ~1e-6 m)."""
     base = dict(n_nodes=3, E=2.1e12, payload=1000.0, contact_distribution=False)
-    from sim_core.telescopic import simulate_telescopic
+    from sim_core.systems.telescopic.build import simulate_telescopic
     r0 = simulate_telescopic(TelescopicParams(friction=False, **base), 0.05, 6, rtol=1e-8, atol=1e-10)
     r1 = simulate_telescopic(TelescopicParams(friction=True, mu_static=0.0, mu_dynamic=0.0, **base),
                              0.05, 6, rtol=1e-8, atol=1e-10)

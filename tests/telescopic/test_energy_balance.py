@@ -4,7 +4,7 @@
         = drive work - friction dissipation - stress-filter dissipation,
 
 to the solver tolerance.  The works are integrated as extra states of the same RK45 run
-(sim_core.energy_audit), so the balance residual is an integration error only.
+(sim_core.systems.telescopic.energy_audit), so the balance residual is an integration error only.
 
 Setup: the paper's scene 9.2 (E = 2.1e11 Pa, 25 t, 60 deg, friction 0.1/0.15, v_eps 0.01 m/s,
 filter h = 0.01) at 2 sub-elements per spline element, from its static equilibrium, with the
@@ -19,8 +19,9 @@ the defaults (rigid, resultant) run in the default suite, the other five in the 
 import numpy as np
 import pytest
 
-from sim_core.energy_audit import run_energy_audit
-from sim_core.telescopic import TelescopicParams, build_telescopic, initial_equilibrium
+from sim_core.systems.telescopic.params import TelescopicParams
+from sim_core.systems.telescopic.build import build_telescopic, initial_equilibrium
+from sim_core.systems.telescopic.energy_audit import run_energy_audit
 
 RTOL = 1e-6
 

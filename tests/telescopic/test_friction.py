@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from sim_core.telescopic import TelescopicParams, build_telescopic, initial_equilibrium
+from sim_core.systems.telescopic.params import TelescopicParams
+from sim_core.systems.telescopic.build import build_telescopic, initial_equilibrium
 
 
 @pytest.fixture(scope="module")
@@ -58,7 +59,7 @@ def test_friction_dissipates_and_balances_the_axial_reaction(systems):
         assert abs(mu) == pytest.approx(0.1, abs=1e-12)         # beyond 2 v_eps: mu_dynamic
         assert sol.total_normal_force > 0.0
         if name.startswith("I_"):
-            from sim_core.contact_friction import section_reaction
+            from sim_core.physics.contact.friction import section_reaction
             point = next(p for n_, p, _, _ in fr.regions if n_ == name)
             f_sec, _ = section_reaction(point, Q, lam[ts_f.rows[name + "_point"]],
                                         lam[ts_f.rows[name + "_angles"]], fr.basis)
@@ -70,7 +71,7 @@ def test_resultant_friction_load_balances_the_axial_reaction(systems):
     auxiliary equation Eq. 72) is mu times the transverse contact resultant |(f_t, f_b)| - the
     Coulomb ratio between the constraint force's axial and normal components that Section 9.2
     (4) describes - up to the curvature coupling term (booms nearly straight: < 1 %)."""
-    from sim_core.contact_friction import region_multipliers, section_reaction
+    from sim_core.physics.contact.friction import region_multipliers, section_reaction
     _, _, z = systems
     ts = build_telescopic(TelescopicParams(n_nodes=3, E=2.1e12, payload=1000.0, friction=True,
                                            friction_load="resultant"))
@@ -127,7 +128,7 @@ def test_multiplier_newton_matches_the_converged_fixed_point(systems, distributi
     It must give the fixed point's solution (iterated to 1e-13, relative), and - its Jacobian
     being the analytic micro-motion sensitivity - in fewer friction evaluations than the fixed
     point needs for the default 1e-8 (a wrong sensitivity loses the quadratic convergence)."""
-    import sim_core.contact_friction as cf
+    import sim_core.physics.contact.friction as cf
 
     ts_f, _, z = systems
     m = ts_f.model
@@ -201,7 +202,7 @@ def test_compiled_regions_equal_the_region_by_region_values(systems):
     regions_values) give the region-by-region values and gradients of the reference path
     (normal_load per region) within the micro-motion solver's tolerance; without warm starts
     (cold start needed) the compiled call declines and the reference path answers."""
-    from sim_core.contact import micro_motion_compiled
+    from sim_core.physics.contact import _sliding_block_contact_numba as micro_motion_compiled
     if not micro_motion_compiled.AVAILABLE:
         pytest.skip("numba not installed")
     ts_f, _, z = systems
@@ -231,7 +232,7 @@ def test_section_reaction_maps_closed_form_equals_the_inverse():
     """The closed-form T^-T of section_reaction_maps (det T = cos beta) against the frame of
     cardan_frame and numpy's inverse, at random angles and a random orthonormal basis, for 3
     and 2 angle rows; a complex-step state takes the inverse path."""
-    from sim_core.contact_friction import _section_reaction_maps_inv, section_reaction_maps
+    from sim_core.physics.contact.friction import _section_reaction_maps_inv, section_reaction_maps
     rng = np.random.default_rng(7)
     basis, _ = np.linalg.qr(rng.normal(size=(3, 3)))
     for _ in range(20):
@@ -259,7 +260,7 @@ def test_compiled_multiplier_newton_equals_the_python_loop(systems, v):
     Model._multiplier_newton, sliding (|v| > 2 v_eps), in the stick band and backwards: the
     same operations, so the same accelerations and multipliers to round-off (both warm-start
     the micro-motions from the same solutions)."""
-    from sim_core.contact import micro_motion_compiled
+    from sim_core.physics.contact import _sliding_block_contact_numba as micro_motion_compiled
     if not micro_motion_compiled.AVAILABLE:
         pytest.skip("numba not installed")
     ts_f, _, z = systems

@@ -6,8 +6,9 @@ import math
 import numpy as np
 import pytest
 
-from sim_core.rigid_telescopic import RigidTelescopic
-from sim_core.telescopic import TelescopicParams, build_telescopic, initial_equilibrium
+from sim_core.systems.telescopic.params import TelescopicParams
+from sim_core.systems.telescopic.build import build_telescopic, initial_equilibrium
+from sim_core.systems.telescopic.rigid import RigidTelescopic
 from sim_core.validation.closed_form import Z_C_DEFAULT, static_luffing_forces
 
 TH = math.radians(60.0)

@@ -9,7 +9,7 @@ to the rotations of the sections, phi <= P L^2 / (2 EI_3) ~ 1e-4 rad.
 Notation: P = m_p g cos(theta) = 122.6 kN, the payload's weight across the booms (along e_b);
 a = L - L_s the overlap of adjacent booms (L = 10 m); each contact region's force and moment
 are those the constraint (or the seat) exerts on its second body, in section components
-(s, t, b) (sim_core.contact_friction.section_reaction).
+(s, t, b) (sim_core.physics.contact.friction.section_reaction).
 
 couple: the bending angles are free, so no region carries a bending moment and each overlap is
 a beam on two supports.  Boom 3 (loaded by P at its tip, L from its left end) rests on region
@@ -48,9 +48,10 @@ import functools
 import numpy as np
 import pytest
 
-from sim_core.constraints import material_point
-from sim_core.contact_friction import region_multipliers, section_reaction
-from sim_core.telescopic import TABLE2, TelescopicParams, build_telescopic, initial_equilibrium
+from sim_core.physics.constraints import material_point
+from sim_core.physics.contact.friction import region_multipliers, section_reaction
+from sim_core.systems.telescopic.params import TABLE2, TelescopicParams
+from sim_core.systems.telescopic.build import build_telescopic, initial_equilibrium
 
 L = 10.0
 THETA = np.radians(60.0)

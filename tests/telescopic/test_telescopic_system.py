@@ -7,8 +7,9 @@ checked quantities are resultants and rigid-limit kinematics that do not need th
 import numpy as np
 import pytest
 
-from sim_core.simulate import integrate
-from sim_core.telescopic import TelescopicParams, build_telescopic, initial_equilibrium
+from sim_core.integrate.driver import integrate
+from sim_core.systems.telescopic.params import TelescopicParams
+from sim_core.systems.telescopic.build import build_telescopic, initial_equilibrium
 from sim_core.validation.closed_form import rigid_tip_kinematics, static_luffing_forces
 
 
@@ -123,8 +124,8 @@ def test_overlap_transition_at_five_metres_has_no_spike():
     it (4.95 -> 5.15 m, fast cubic schedule, nearly rigid booms): the constraint violation stays
     at the Baumgarte-stabilised level (< 1e-6 m; measured ~1e-11 before, ~1e-7 after the
     crossing) and the tip displacement follows the rigid-boom model with the same elastic ropes
-    (sim_core.rigid_telescopic) within 1 mm (boom elasticity at E = 2.1e12 Pa)."""
-    from sim_core.telescopic import simulate_telescopic
+    (sim_core.systems.telescopic.rigid) within 1 mm (boom elasticity at E = 2.1e12 Pa)."""
+    from sim_core.systems.telescopic.build import simulate_telescopic
     kw = dict(n_nodes=3, E=2.1e12, payload=1000.0, stroke0=4.95, v_max=0.5, t_ramp=0.2,
               t_hold_end=0.4)
     res = simulate_telescopic(TelescopicParams(**kw), t_end=0.6, n_output=61, rtol=1e-7,

@@ -1,0 +1,348 @@
+"""The integration driver: a model's reduced first-order system y = (z, z_dot) from t = 0 to
+t_end with RK45, BDF or both switched by stiffness (``solver.method``), a wall-clock budget,
+stall detection and partial results.  It knows the model's protocol (``rhs``, ``n_dof``, the
+structured Jacobian), never a scene.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+from scipy.integrate import BDF, RK45
+
+from sim_core.errors import ElementEvaluationError, SimulationError, StalledIntegration
+from sim_core.integrate.bdf import (
+    BDF_NEWTON_ITERATIONS,
+    RefreshedJacobian,
+    SecondOrderNewtonLU,
+    bdf_newton_limit,
+)
+from sim_core.integrate.checks import check_result, result_checks
+from sim_core.integrate.switching import MethodSwitch
+from sim_core.model.model import Model
+from sim_core.scene.fields import SOLVER_METHODS
+
+
+class _CountingRHS:
+    """Wraps model.rhs: counts evaluations.  A stage evaluation that fails (overflow, singular
+    KKT matrix, non-finite accelerations) is a *recoverable* failure, as in SUNDIALS: the stage
+    returns huge derivatives so that the error estimate rejects the step and RK45 retries with a
+    smaller one.  After ``max_failures`` consecutive failed evaluations, or if an accepted state
+    is non-finite (checked by the caller), it raises SimulationError with the time and reason."""
+
+    BIG = 1e100
+    max_failures = 40
+
+    def __init__(self, model):
+        self.model = model
+        self.nfev = 0
+        self.jac_cost = 0.0          # structured Jacobians, in right-hand-side equivalents
+        self.n_jacobians = 0         # structured Jacobians
+        self.n_refreshes = 0         # their non-smooth columns refreshed (RefreshedJacobian)
+        self.last_t = 0.0
+        self.failures = 0
+        self.n_failed = 0
+        self.last_reason = ""
+
+    def __call__(self, t, y):
+        self.nfev += 1
+        self.last_t = t
+        reason = None
+        try:
+            with np.errstate(over="raise", divide="raise", invalid="raise", under="ignore"):
+                out = self.model.rhs(t, y)
+            if not np.all(np.isfinite(out)):
+                reason = "non-finite accelerations"
+        except (FloatingPointError, np.linalg.LinAlgError) as exc:
+            reason = f"non-finite or singular dynamics: {exc}"
+        except ElementEvaluationError as exc:       # on the worker thread or this one
+            reason = exc.reason
+        except (ZeroDivisionError, OverflowError) as exc:
+            reason = f"element or constraint evaluation failed: {type(exc).__name__}: {exc}"
+        if reason is None:
+            self.failures = 0
+            return out
+        return self._failed(t, y, reason)
+
+    @property
+    def cost(self) -> float:
+        """Model work so far in right-hand-side evaluations (Jacobians included)."""
+        return self.nfev + self.jac_cost
+
+    def jacobian(self, t, y):
+        """Structured Jacobian (:mod:`sim_core.model.state_jacobian`) for BDF, its cost counted."""
+        from sim_core.model.state_jacobian import state_jacobian
+        try:
+            with np.errstate(over="raise", divide="raise", invalid="raise", under="ignore"):
+                J, cost = state_jacobian(self.model, t, y, return_cost=True)
+            if not np.all(np.isfinite(J)):
+                raise FloatingPointError("non-finite Jacobian entries")
+        except (FloatingPointError, np.linalg.LinAlgError, ZeroDivisionError, OverflowError,
+                ElementEvaluationError) as exc:
+            why = exc.reason if isinstance(exc, SimulationError) else exc
+            raise SimulationError(t, f"Jacobian evaluation failed: {why}", last_state=y) from None
+        self.jac_cost += cost
+        self.n_jacobians += 1
+        return J
+
+    def _failed(self, t, y, reason):
+        self.failures += 1
+        self.n_failed += 1
+        self.last_reason = reason
+        if self.failures > self.max_failures:
+            raise SimulationError(t, f"{reason} ({self.failures} consecutive failed stage "
+                                     "evaluations; step size could not recover)", last_state=y)
+        return np.full(len(y), self.BIG)
+
+
+class StallMonitor:
+    """Raises :class:`StalledIntegration` when the run cannot finish at the pace of its last
+    ``window`` accepted steps:
+
+    * their mean step is below ``t_end / max_steps`` (a pace at which the whole run would take
+      more than ``max_steps`` steps), or
+    * with a wall-clock budget ``budget`` (s): at least ``min_budget_share`` of it is spent and
+      the remaining simulated time, at the window's pace in simulated seconds per wall second,
+      would take more than ``overrun`` times the budget left -- the budget would run out
+      anyway, so the run stops now, naming the stall, instead of at the budget.
+
+    Why these numbers.  ``max_steps`` = 1e6 is ~400 times the shipped scenes' step counts (the
+    paper's extraction: 2477 steps for 20 s, its retraction 11311) and 10 min to hours of wall
+    time at 0.1-1 ms per model evaluation.  Healthy runs do shorten their steps at events
+    (friction sticking and slipping, contact changes), but for tens of steps: the paper run's
+    smallest step is 5e-6 s (2.5e-7 t_end), while its shortest mean over 1000 accepted steps
+    is 8.8e-3 s (4.4e-4 t_end, 440 times the floor; ``min_window_mean_step_s`` in the
+    statistics); a mean over ``window`` = 1000 accepted steps ignores such dips and still
+    fires within about 1000 steps of a collapse.  The budget test
+    starts after 10 % of the budget (the pace of the first steps, compiled code loading and
+    the initial transient, is no guide) and asks for a threefold overrun, so that a run whose
+    pace recovers later (a stiff stretch that ends) is not stopped: the stalls it is for are
+    ten to a hundred times too slow (the 2-sub-element rod drawn through the sleeve without
+    the stress filter, BDF at rtol 1e-4: steps of ~1e-5 s against 8 s to go, 0.65 s simulated
+    in 120 s of wall time).  The last step of a run (cut to land on t_end) is not
+    monitored."""
+
+    window = 1000
+    max_steps = 1e6
+    min_budget_share = 0.1
+    overrun = 3.0
+
+    def __init__(self, t_end: float, window: int | None = None, max_steps: float | None = None,
+                 budget: float | None = None, wall0: float | None = None):
+        self.window = int(window or self.window)
+        self.max_steps = float(max_steps or self.max_steps)
+        self.t_end = float(t_end)
+        self.floor = self.t_end / self.max_steps
+        self.budget = budget
+        self.wall0 = time.perf_counter() if wall0 is None else wall0
+        self.times = np.zeros(self.window)       # t after each of the last accepted steps
+        self.walls = np.zeros(self.window)       # wall clock then
+        self.k = 0
+        self.slowest = math.inf          # smallest window mean step so far, s
+
+    def update(self, solver) -> None:
+        """Call after every accepted step that is not the last one."""
+        i = self.k % self.window
+        t_old = self.times[i] if self.k >= self.window else 0.0
+        wall_old = self.walls[i] if self.k >= self.window else self.wall0
+        now = time.perf_counter()
+        self.times[i], self.walls[i] = solver.t, now
+        self.k += 1
+        n = min(self.k, self.window)
+        if self.k >= self.window:
+            mean = (solver.t - t_old) / n
+            self.slowest = min(self.slowest, mean)
+            if mean < self.floor:
+                self._raise(solver, "integration stalled", mean, n,
+                            f"below t_end / {self.max_steps:.0e} = {self.floor:.3g} s")
+        if self.budget is not None and now - self.wall0 >= self.min_budget_share * self.budget:
+            pace = (solver.t - t_old) / max(now - wall_old, 1e-9)   # simulated s per wall s
+            need = (self.t_end - solver.t) / max(pace, 1e-300)
+            left = self.budget - (now - self.wall0)
+            if 0.0 < left < need / self.overrun:       # (spent: the budget's own error)
+                self._raise(solver, "integration too slow for its wall-clock budget",
+                            (solver.t - t_old) / n, n,
+                            f"a pace at which the remaining {self.t_end - solver.t:.3g} s would "
+                            f"take ~{need:.3g} s of wall time, more than {self.overrun:g} x the "
+                            f"{left:.3g} s left of solver.max_wall_s = {self.budget:g} s",
+                            "either the steps are too short (")
+
+    def _raise(self, solver, what: str, mean: float, n: int, why: str, lead: str = "("):
+        rest = self.t_end - solver.t
+        hint = ("stiff or non-smooth dynamics the method cannot follow at this tolerance: try "
+                "another solver.method or rtol, or the stress filter)")
+        if lead != "(":
+            hint += " or the budget is too small for this scene"
+        raise StalledIntegration(
+            solver.t, f"{what}: the last {n} accepted steps averaged {mean:.3g} s "
+            f"(~{rest / max(mean, 1e-300):.2g} more steps to t_end), {why}; {lead}{hint}",
+            mean_step=mean, window=n, step=solver.t - solver.t_old, last_state=solver.y)
+
+
+def integrate(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
+    """Integrate model.rhs from t = 0 with dense output at ``sol["n_output"]`` equally spaced
+    times.  ``sol["method"]``:
+
+    * ``"RK45"`` (default): scipy's explicit Dormand-Prince pair — cheapest per step while the
+      step size is set by accuracy;
+    * ``"BDF"``: scipy's variable-order BDF — for stiff runs (sticking friction, stiff contact).
+      Its Jacobian (``sol["jacobian"]``): ``"structured"`` (default for :class:`sim_core.model.model.
+      Model`) by implicit differentiation with local differences (:mod:`sim_core.
+      state_jacobian`, ~1/6 of the cost at the paper's discretisation), or
+      ``"finite_difference"``: scipy's differences of the whole right-hand side (one model.rhs
+      per state per Jacobian);
+    * ``"auto"``: RK45 and BDF alternate as :class:`MethodSwitch` decides (RK45 -> BDF when
+      :class:`StiffnessDetector` finds the step stability-limited, back to RK45 after a
+      stretch whose length adapts to which method was cheaper); the statistics record the
+      number of switches and the first switch to BDF.
+
+    Returns (t, y, stats); raises SimulationError with the time, step and last good state on
+    failure or non-finite values, when the optional wall-clock budget ``sol["max_wall_s"]`` (s)
+    is exhausted, or on Ctrl-C (KeyboardInterrupt), and :class:`StalledIntegration` where the
+    steps cannot finish the run (:class:`StallMonitor`: within ``sol["stall_max_steps"]``
+    steps, default 1e6, or the budget); the outputs reached so far are attached, so a
+    budgeted, stalled or interrupted run still yields a partial result.  The statistics
+    include rtol, atol, the shortest mean step over the stall monitor's window and, for a
+    :class:`sim_core.model.model.Model`, its element worker's governor
+    (:meth:`sim_core.model.workers.Governor.summary`)."""
+    method = sol.get("method", "RK45")
+    if method not in SOLVER_METHODS:
+        raise ValueError(f"solver.method = {method!r}: must be one of {SOLVER_METHODS}")
+    t_eval = np.linspace(0.0, t_end, sol["n_output"])
+    rhs = _CountingRHS(model)
+    kwargs = {"max_step": sol["max_step"]} if "max_step" in sol else {}
+    budget = sol.get("max_wall_s")
+    wall0 = time.perf_counter()
+    tol = {"rtol": sol["rtol"], "atol": sol["atol"]}
+
+    structured = sol.get("jacobian", "structured") == "structured" and isinstance(model, Model)
+
+    steps = []
+    stretch = {}              # the current BDF stretch's RefreshedJacobian
+
+    def make(cls, t0, y):
+        if cls is BDF and structured:
+            stretch["jac"] = RefreshedJacobian(rhs)
+            s = cls(rhs, t0, y, t_end, jac=stretch["jac"], **tol, **kwargs)
+            stretch["jac"].watch(s)
+            newton = SecondOrderNewtonLU(s)             # Newton matrix by its Schur complement
+            s.lu, s.solve_lu = newton.lu, newton.solve_lu
+            return s
+        return cls(rhs, t0, y, t_end, **tol, **kwargs)
+
+    solver = make(BDF if method == "BDF" else RK45, 0.0, y0)
+    # at a BDF stretch's end a fresh Jacobian tells whether RK45 could take BDF's steps; where
+    # it costs less than the RK45 trial it replaces (~100 evaluations): the structured one
+    # (through the stretch's RefreshedJacobian: its friction columns refreshed, where the
+    # stiffness of a sticking contact is; the stress filter's eigenvalue pair is constant), or
+    # finite differences of a small system
+    probe = structured or len(y0) <= 100
+    fresh = (lambda s: stretch["jac"](s.t, s.y)) if structured else (lambda s: s.jac(s.t, s.y))
+    switch = MethodSwitch(rhs, fresh_jacobian=fresh if probe else None) \
+        if method == "auto" else None
+    njev = 0                  # Jacobians of BDF solvers already replaced by a switch
+    newton_limit = bdf_newton_limit(sol.get("bdf_newton_iterations", BDF_NEWTON_ITERATIONS))
+    ys = [y0]
+    k_out = 1
+    stall = StallMonitor(t_end, sol.get("stall_window"), sol.get("stall_max_steps"), budget,
+                         wall0)
+
+    def stats():
+        wall = time.perf_counter() - wall0
+        # the smallest accepted step, not counting the last one of a finished run: the solver
+        # cuts that one to land on t_end, so its length is set by where t_end falls, not by the
+        # dynamics (a run whose steps collapse elsewhere still shows it)
+        inner = steps[:-1] if solver.status == "finished" and len(steps) > 1 else steps
+        out = {"wall_time_s": wall, "n_steps": len(steps), "n_rhs": int(rhs.nfev),
+               "n_failed_rhs": int(rhs.n_failed),
+               "min_step_s": float(min(inner)) if inner else 0.0,
+               "max_step_s": float(max(steps)) if steps else 0.0,
+               "method": method, "real_time_factor": t_end / max(wall, 1e-12),
+               "rtol": float(np.max(sol["rtol"])), "atol": float(np.max(sol["atol"]))}
+        if math.isfinite(stall.slowest):    # the shortest mean step over StallMonitor's window
+            out["min_window_mean_step_s"] = float(stall.slowest)
+        if isinstance(model, Model) and "_governor" in model.__dict__:
+            out.update(model.governor().summary())
+        if method != "RK45":
+            if structured:      # whole ones, their work in right-hand sides (element
+                # evaluations / elements), and refreshes of their non-smooth columns (their
+                # right-hand sides are in n_rhs)
+                out["n_jacobians"] = rhs.n_jacobians
+                out["jacobian_cost_rhs"] = float(rhs.jac_cost)
+                out["n_jacobian_refreshes"] = rhs.n_refreshes
+            else:
+                out["n_jacobians"] = njev + int(getattr(solver, "njev", 0))
+        if switch is not None:
+            out["n_method_switches"] = len(switch.switches)
+            out["n_bdf_kept"] = switch.kept_bdf     # stretch ends without a hand-back trial
+            out["first_switch_to_bdf_s"] = switch.switches[0][0] if switch.switches else -1.0
+            out["last_switch_s"] = switch.switches[-1][0] if switch.switches else -1.0
+        return out
+
+    try:
+        while solver.status == "running":
+            if isinstance(solver, BDF):
+                with newton_limit:
+                    msg = solver.step()
+                if structured:
+                    stretch["jac"].after_step()
+            else:
+                msg = solver.step()
+            if solver.status == "failed" or not np.all(np.isfinite(solver.y)):
+                why = (f" after {rhs.failures} failed stage evaluations ({rhs.last_reason})"
+                       if rhs.failures else "")
+                name = "BDF" if isinstance(solver, BDF) else "RK45"
+                raise SimulationError(solver.t, f"{name} failed: {msg}{why}", step=solver.step_size,
+                                      last_state=solver.y)
+            steps.append(solver.t - solver.t_old)
+            if solver.status == "running":
+                stall.update(solver)
+            if k_out < len(t_eval) and t_eval[k_out] <= solver.t:
+                dense = solver.dense_output()
+                while k_out < len(t_eval) and t_eval[k_out] <= solver.t:
+                    ys.append(dense(t_eval[k_out]))
+                    k_out += 1
+            if progress is not None:
+                progress(solver.t, time.perf_counter() - wall0)
+            if budget is not None and solver.status == "running" \
+                    and time.perf_counter() - wall0 > budget:
+                raise SimulationError(solver.t, f"wall-clock budget solver.max_wall_s = {budget:g} s "
+                                      f"exhausted (last step {solver.step_size:.3g} s)",
+                                      step=solver.step_size, last_state=solver.y)
+            if switch is not None and solver.status == "running":
+                old = solver
+                solver = switch.after_step(solver, make)
+                if solver is not old:
+                    njev += int(getattr(old, "njev", 0))
+    except KeyboardInterrupt:              # Ctrl-C keeps what was computed, like a budget
+        exc = SimulationError(solver.t, "interrupted by the user (KeyboardInterrupt)",
+                              step=solver.step_size, last_state=solver.y)
+        exc.partial = (t_eval[:len(ys)], np.array(ys), stats())
+        raise exc from None
+    except SimulationError as exc:
+        # keep what was computed: the caller turns it into a partial Result (exc.result)
+        exc.partial = (t_eval[:len(ys)], np.array(ys), stats())
+        raise
+    return t_eval[:len(ys)], np.array(ys), stats()
+
+
+def run_with_partial(integrate, collect, check=None):
+    """integrate() -> (t, y, stats); collect(t, y, stats, error) -> Result.  On a
+    SimulationError the outputs up to the failure are collected and attached as exc.result.
+    A finished run is checked (:func:`check_result`; ``check(result)``: the scene kind's own
+    checks, a dict as :func:`result_checks` returns): the verdict goes into its statistics,
+    and a gross failure raises :class:`SuspectResult` with the result attached."""
+    try:
+        ts, ys, st = integrate()
+    except SimulationError as exc:
+        part = getattr(exc, "partial", None)
+        if part is not None and len(part[0]):
+            exc.result = collect(*part, str(exc))
+        raise
+    res = collect(ts, ys, st, None)
+    checks = result_checks(res)
+    if check is not None:
+        checks.update(check(res))
+    return check_result(res, checks)

@@ -1,0 +1,410 @@
+"""Telescopic boom system of Zhao-Qi-Wang 2024 (Sections 2, 5-7, 9): nested flexible booms with
+moving contact constraints, luffing cylinder, telescopic cylinder, ropes and payload.
+
+Contact regions carry their moment by the scene's ``contact.moment_model``: ``rigid`` (Section 6
+as printed: the sections' Cardan angles coincide), ``seat`` (the bending angles tied by an
+elastic seat, point_effects.SliderSeat) or ``couple`` (the bending angles free, so an overlap
+carries its moment as a force couple between its two regions).  The friction of Section 8.3
+takes its normal load from ``contact.friction_load`` (sim_core.physics.contact.friction).
+
+Booms are numbered from the outermost (1).  Each boom is two moving-node spline elements split
+at its outer contact point (boom 1: at the luffing point s = L_h, a material point, Eq. 50);
+the end nodes are material points (s_1,k = 0, s_4,k = L_k, Eq. 50).  The inner contact point of
+boom k < N is not a node: its arc-length coordinate s_2,k is an extra generalized coordinate
+(Section 5) and the point is interpolated with Eq. 6.
+
+Constraint I (Eq. 47): centroid and Cardan angles of boom k+1's left end = those of boom k at
+s_2,k.  Constraint II (Eq. 48): boom k's right end = boom k+1's outer-contact node s_3,k+1.
+Their multipliers are the contact force/moment resultants; the generalized forces they exert
+on s_2,k and s_3,k+1 are the contact multipliers eta of Section 7 (zero without friction).
+
+Mounting and drives (SCENARIOS A2-A4, proposed defaults): revolute pivot D1 about Y (rigid
+offset from boom 1's left section), luffing cylinder = massless rigid rod D2-D3 of constant
+length (its multiplier is the cylinder force), telescopic cylinder = massless actuator imposing
+the distance L_s(t) between the left-section centres of booms 1 and 2, elastic tension-only
+extraction and retraction ropes over point pulleys, payload point mass at boom N's tip.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from sim_core.model.boundary import boundary_condition, fix_material_coordinate, no_torsion, reference_basis
+from sim_core.model.model import Model
+from sim_core.physics.beam.moving_node_beam import Beam
+from sim_core.physics.constraints import (
+    NonlinearConstraint,
+    angle_coincidence,
+    distance_driver,
+    fixed_point,
+    material_point,
+    point_coincidence,
+    rope_length,
+)
+from sim_core.physics.drive_profiles import CubicSmoothstepSchedule
+from sim_core.physics.effects import Effect, Elasticity, Gravity, Inertia, StressFilter
+from sim_core.physics.point_effects import PointMass, RopeDrive, SliderSeat
+from sim_core.systems.telescopic.luffing import luffing_geometry
+from sim_core.systems.telescopic.params import TelescopicParams, boom_section
+
+
+@dataclass
+class TelescopicSystem:
+    model: Model
+    Q0: np.ndarray
+    schedule: CubicSmoothstepSchedule
+    s2_index: list[int]                     # coordinates of the inner contact points s_2,k
+    s3_index: list[int]                     # coordinates of the outer contact points s_3,k
+    rows: dict[str, slice]                  # nonlinear-constraint rows by name
+    tip: callable                           # point function of the tip (boom N, s = L)
+    params: TelescopicParams
+    contact: object = None                  # contact_friction.ContactFriction, if built
+    # per contact region ("I_12", "II_12", ...): the Cardan-angle rows kept as constraints
+    # (0, 1 bending, 2 twist) and, for the seat model, its point_effects.SliderSeat
+    angle_rows: dict = field(default_factory=dict)
+    seats: dict = field(default_factory=dict)
+
+
+def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
+    theta = np.radians(p.luffing_angle_deg)
+    geo = luffing_geometry(theta)
+    e = np.asarray(geo.e_s, float)
+    O1 = np.asarray(geo.origin, float)
+    L, N, Ls = p.boom_length, p.n_booms, p.stroke0
+    G = reference_basis(e)
+    beams = []
+    for k in range(N):
+        split = p.L_h if k == 0 else L - Ls
+        beams.append(Beam(f"boom{k + 1}", L, boom_section(k, p), (0.0, split, L),
+                          n_nodes=p.n_nodes, n_gauss=p.n_gauss, reference_basis=G))
+    offsets = np.cumsum([0] + [b.n_coords for b in beams])[:-1]
+    g_vec = np.array([0.0, 0.0, -p.gravity])
+    effects: list[Effect] = [Inertia(), Elasticity()]
+    if p.filter_h > 0:
+        effects.append(StressFilter(p.filter_h))
+    if p.gravity > 0:
+        effects.append(Gravity(g_vec))
+    lin = []
+    for ib in range(N):
+        for end in ("left", "right"):
+            lin.append(boundary_condition(offsets, beams, ib, end, "free"))
+    lin.append(fix_material_coordinate(offsets, beams, 0, 1, p.L_h))
+    if not p.torsion:
+        lin.append(no_torsion(offsets, beams))
+    model = Model(beams, effects, [], lin, n_extra=N - 1, baumgarte=p.baumgarte)
+
+    # initial straight configuration: boom k's left section a_k = k L_s along boom 1 (A3)
+    Q0 = np.zeros(model.n_coords)
+    for k, b in enumerate(beams):
+        Q0[offsets[k]:offsets[k] + b.n_coords] = b.straight_coordinates(O1 + k * Ls * e, e)
+    n_beam = int(sum(b.n_coords for b in beams))
+    s2_index = [n_beam + k for k in range(N - 1)]
+    Q0[s2_index] = Ls
+    s3_index = [int(offsets[k] + beams[k].s_coord(1)) for k in range(N)]
+
+    def mp(k, **kw):
+        return material_point(model, k, **kw)
+
+    cons: list[NonlinearConstraint] = []
+    names: list[tuple[str, int]] = []
+
+    def add(c):
+        cons.append(c)
+        names.append((c.name, c.m))
+
+    # effects.torsion = false: the torsion angles gamma are held at zero, so the gamma rows of the
+    # angle coincidences would read 0 = 0 (a singular KKT matrix) and are left out
+    bend = [0, 1] if not p.torsion else [0, 1, 2]
+
+    def angles(name, fa, fb=None, fixed=None, keep=(0, 1, 2)):
+        c = angle_coincidence(name, fa, fb, fixed=fixed)
+        k = [i for i in keep if i in bend]
+        return c if len(k) == 3 else _rows(c, k)
+
+    # pivot D1: revolute about Y (point fixed, beta = gamma = 0 at boom 1's left section)
+    D1 = mp(0, s_fixed=0.0, offset=(-0.956, 0.0, 0.556))
+    add(point_coincidence("pivot", D1, fixed=geo.d1))
+    root = mp(0, s_fixed=0.0)
+    add(angles("pivot_axis", root, fixed=[0.0, 0.0, 0.0], keep=(1, 2)))
+    # luffing cylinder: rigid massless rod D2-D3 held at its initial length (A2)
+    D3 = mp(0, s_fixed=p.L_h, offset=(0.0, 0.0, -0.556))
+    Lc = float(geo.cylinder_length)
+    add(distance_driver("luffing_cylinder", D3, fixed_point(geo.d2), lambda t: (Lc, 0.0, 0.0)))
+    # contact constraints I and II between adjacent booms (Section 6).  The moment model decides
+    # which Cardan-angle rows stay constraints: all three (rigid, Eqs. 47-48), or the twist only
+    # (seat: the bending rows become an elastic seat; couple: they are free)
+    if p.moment_model not in ("rigid", "seat", "couple"):
+        raise ValueError(f"moment_model = {p.moment_model!r} (allowed: 'rigid', 'seat', "
+                         "'couple')")
+    kept = tuple(bend) if p.moment_model == "rigid" else tuple(i for i in bend if i == 2)
+    angle_rows, seats = {}, {}
+
+    def contact_region(name, fa, fb):
+        add(point_coincidence(name + "_point", fa, fb))
+        angle_rows[name] = kept
+        if kept:
+            add(angles(name + "_angles", fa, fb, keep=kept))
+        if p.moment_model == "seat":
+            seats[name] = SliderSeat(_rows(angle_coincidence(name + "_seat", fa, fb), [0, 1]),
+                                     p.seat_stiffness, name=name + "_seat")
+
+    for k in range(N - 1):
+        contact_region(f"I_{k + 1}{k + 2}", mp(k + 1, s_fixed=0.0), mp(k, s_index=s2_index[k]))
+        contact_region(f"II_{k + 1}{k + 2}", mp(k, s_fixed=L), mp(k + 1, s_index=s3_index[k + 1]))
+    # telescopic cylinder between the left sections of booms 1 and 2 (A3, A4)
+    sched = CubicSmoothstepSchedule(v_max=p.v_max, t_ramp=p.t_ramp, t_hold_end=p.t_hold_end,
+                                    sign=p.direction, s0=Ls)
+    def cylinder_length(t):                        # one sample of the schedule: (L, L', L'')
+        smp = sched.sample(t)
+        return smp.s, smp.v, smp.a
+
+    add(distance_driver("telescopic_cylinder", mp(1, s_fixed=0.0), mp(0, s_fixed=0.0),
+                        cylinder_length))
+    model.nonlinear = cons
+    rows, i = {}, 0
+    for nm, m in names:
+        rows[nm] = slice(i, i + m)
+        i += m
+
+    tip = mp(N - 1, s_fixed=L)
+    pe = []
+    if p.payload > 0:
+        pe.append(PointMass(tip, p.payload, g_vec if p.gravity > 0 else None))
+    if N >= 3:
+        ext = [mp(0, s_fixed=0.0, offset=(0.05, 0, 0)), mp(1, s_fixed=9.0),
+               mp(2, s_fixed=0.0, offset=(-0.04, 0, 0))]
+        ret = [mp(0, s_fixed=L, offset=(0.68, 0, 0)), mp(1, s_fixed=0.66),
+               mp(2, s_fixed=0.0, offset=(0.64, 0, 0))]
+        if p.rope_elasticity:
+            EA = p.rope_EA * p.E / 2.1e11
+            rope = RopeDrive(ext, EA, 1.0, name="extraction_rope")
+            ell_e = float(rope.length(Q0)[0])
+            # unstretched length from the static rope tension of the rigid, frictionless boom:
+            # T = (m3 + m_p) g sin(theta) (SCENARIOS C7; m3 = boom 3's mass, Table 2)
+            m3 = p.boom_length * p.sections[min(2, len(p.sections) - 1)][2]
+            T0 = (m3 + p.payload) * p.gravity * math.sin(theta)
+            rope.L0 = ell_e / (1.0 + T0 / EA)
+            retr = RopeDrive(ret, EA, 1.0, name="retraction_rope")
+            retr.L0 = float(retr.length(Q0)[0])         # just taut
+            pe += [rope, retr]
+        else:
+            # effects.rope_elasticity = false: one inextensible bilateral rope (its multiplier's
+            # sign tells which of the two ropes is taut); nothing of the rope springs is computed
+            ell_e = float(np.real(rope_length("rope", ext, 0.0).evaluate(Q0)[0][0]))
+            c = rope_length("rope", ext, ell_e)
+            cons.append(c)
+            rows["rope"] = slice(i, i + 1)
+            model.nonlinear = cons
+    model.point_effects = pe + list(seats.values())
+    ts = TelescopicSystem(model, Q0, sched, s2_index, s3_index, rows, tip, p,
+                          angle_rows=angle_rows, seats=seats)
+    # Section 8 contact analysis: the slider-spring distribution needs the paper's three-boom
+    # slider geometry; with friction off it is only evaluated for the outputs (it does not act
+    # on the motion), with contact_distribution off it is not built at all
+    if p.contact_distribution is None:
+        p.contact_distribution = N == 3
+    if p.contact_distribution and N != 3:
+        raise ValueError(f"contact_distribution with n_booms = {N}: the slider geometry is the "
+                         "paper's three-boom section (allowed: 3)")
+    if p.friction and p.friction_load == "springs" and not p.contact_distribution:
+        raise ValueError("friction_load = 'springs' needs contact_distribution (the slider "
+                         "springs); allowed: friction_load = 'resultant'")
+    if p.friction or p.contact_distribution:
+        from sim_core.physics.contact.friction import ContactFriction
+        ts.contact = ContactFriction(ts, p.mu_static, p.mu_dynamic, p.v_eps, p.spring_k0,
+                                     p.spring_eps, distribution=p.contact_distribution,
+                                     slider_half_width=0.5 * p.slider_width,
+                                     springs_per_quarter=p.springs_per_quarter,
+                                     radial_gap=p.radial_gap, friction_load=p.friction_load)
+    if p.friction:
+        model.multiplier_forces = [ts.contact]
+    return ts
+
+
+def _rows(c: NonlinearConstraint, keep: list[int]) -> NonlinearConstraint:
+    """A constraint restricted to some of its rows."""
+    ev = c.evaluate
+    tgt = c.target
+
+    def evaluate(Q):
+        g, J = ev(Q)
+        return g[keep], J[keep]
+
+    def target(t):
+        b, bd, bdd = tgt(t)
+        return b[keep], bd[keep], bdd[keep]
+    prog = None if c.program is None else (c.program[0], tuple(c.program[1][i] for i in keep),
+                                           c.program[2])
+    return NonlinearConstraint(c.name, len(keep), evaluate, None if tgt is None else target,
+                               points=c.points, program=prog)
+
+
+def initial_equilibrium(ts: TelescopicSystem, t: float = 0.0):
+    """Static equilibrium at t = 0 with the rope lengths of SCENARIOS A3: the retraction rope is
+    'just taut' *at the equilibrium*: it is slack while the equilibrium is solved, then its
+    unstretched length is set to its length there (zero tension, no change of the equilibrium).
+    Returns (z, lambda).
+
+    Two-rope statics (our reading): when the static extraction-rope tension T0 =
+    (m3 + m_p) g sin(theta) (C7) is not clearly in the rope's stiff branch (T0 <= (EA/L0) *
+    slack_width, e.g. payload 0 at 0 deg), both tension-only ropes would sit at their kink with
+    zero axial stiffness and boom 3's axial position is undetermined (Newton stalled at |r| ~
+    0.3 N).  Then the equilibrium is solved with the extraction rope *bilateral* (a linear spring
+    of either sign: the pair of opposing ropes acts as one rope), and afterwards the rope that
+    carries the load is given that tension and the other one is made just taut at the start of
+    its stiff branch (tension (EA/L0) slack_width / 2, ~5 N at the paper's EA); a final
+    tension-only Newton from there leaves both ropes taut and the equilibrium well posed.
+
+    Where Newton does not converge, the statics trace the equilibrium under the weight by load
+    continuation (:func:`sim_core.model.statics.load_continuation`).  At low luffing angles the
+    paper's luffing geometry has a short cylinder lever (0.23 m at 0 deg), and soft booms
+    (E = 2.1e10 Pa) at 0 deg reach a limit point at 0.29 x their own weight: then
+    :class:`~sim_core.errors.NoStaticEquilibrium` is raised, naming the angle and the lever."""
+    from sim_core.errors import NoStaticEquilibrium
+    try:
+        return _initial_equilibrium(ts, t)
+    except NoStaticEquilibrium as exc:
+        # the statics' load continuation found a limit point below the full weight: say why
+        p = ts.params
+        lever = luffing_geometry(math.radians(p.luffing_angle_deg)).lever
+        raise NoStaticEquilibrium(exc.t, exc.load_factor_max, exc.path, reason=(
+            f"no static equilibrium at luffing angle {p.luffing_angle_deg:g} deg (E = {p.E:.3g} "
+            f"Pa, payload {p.payload:g} kg): the equilibrium path under the weight turns back at "
+            f"a limit point at {exc.load_factor_max:.3g} x the full weight.  The luffing "
+            f"cylinder's lever about the pivot D1 is {lever:.3f} m at this angle (0.714 m at "
+            "60 deg) and the booms' deflection shortens it further; the limit load scales with "
+            "E (docs/model.md, 'Initial state and statics')")) from exc
+
+
+def _initial_equilibrium(ts: TelescopicSystem, t: float):
+    from sim_core.model.statics import constrained_static_equilibrium
+    m = ts.model
+    z0, _ = m.reduced_state(t, ts.Q0, np.zeros_like(ts.Q0))
+    ropes = {pe.name: pe for pe in m.point_effects if isinstance(pe, RopeDrive)}
+    ext, retr = ropes.get("extraction_rope"), ropes.get("retraction_rope")
+    if retr is not None:
+        retr.L0 = np.inf
+    if ext is None or retr is None:
+        return constrained_static_equilibrium(m, z0, t)
+
+    def length(rope, z):
+        Q, _ = m.full_state(t, z, np.zeros_like(z))
+        return float(rope.length(Q)[0])
+
+    def taut_L0(rope, ell, T):
+        """Unstretched length with tension-only tension T >= (EA/L0) s / 2 at length ell:
+        (EA/L0)(ell - L0 - s/2) = T."""
+        return rope.EA * (ell - 0.5 * rope.slack_width) / (rope.EA + T)
+
+    k_e = ext.EA / ext.L0
+    if ext.tension(length(ext, z0)) > k_e * ext.slack_width:       # stiff branch: as A3 says
+        z, lam = constrained_static_equilibrium(m, z0, t)
+        retr.L0 = length(retr, z)
+        return z, lam
+    ext.bilateral = True
+    try:
+        z, lam = constrained_static_equilibrium(m, z0, t)
+        ell_e = length(ext, z)
+        T = ext.tension(ell_e)
+    finally:
+        ext.bilateral = False
+    s = ext.slack_width
+    ell_r = length(retr, z)
+    if T >= k_e * s:
+        # the extraction rope carries T in its stiff branch: same forces, nothing to re-solve
+        ext.L0 = taut_L0(ext, ell_e, T)
+        retr.L0 = ell_r
+        return z, lam
+    # near zero or compressive: both ropes taut (the net pull T shared as T_min + max(+-T, 0))
+    T_min = 0.5 * k_e * s
+    ext.L0 = taut_L0(ext, ell_e, T_min + max(T, 0.0))
+    retr.L0 = taut_L0(retr, ell_r, T_min + max(-T, 0.0))
+    return constrained_static_equilibrium(m, z, t)
+
+
+def simulate_telescopic(p: TelescopicParams, t_end: float = 20.0, n_output: int = 201,
+                        rtol: float = 1e-6, atol: float = 1e-7, progress=None,
+                        solver: dict | None = None, scene: dict | None = None):
+    """Run the telescopic scene from its static equilibrium and return a Result with the
+    public outputs of the telescopic contract (tip kinematics, piston stroke, cylinder forces,
+    contact-point resultants, contact coordinates, constraint violation; with friction also the
+    normal force of every slider spring per region (I_12, II_12, I_23, II_23; springs ordered arc
+    by arc P1, P2, P3 as in sim_core.physics.contact) and the signed friction coefficient per region).
+    ``solver``: a validated [solver] table (:func:`sim_core.scene.fields.solver_table`); its entries
+    (method, max_step, max_wall_s, ...) take precedence over the keyword arguments.  ``scene``:
+    the validated scene the result records (a summary of ``p`` where None)."""
+    from sim_core.integrate.driver import integrate, run_with_partial
+    sol = {"t_end": t_end, "rtol": rtol, "atol": atol, "n_output": n_output, **(solver or {})}
+    if not p.flexible:
+        from sim_core.systems.telescopic.rigid import RigidTelescopic
+        return RigidTelescopic(p).simulate(sol["t_end"], sol["n_output"], sol["rtol"], sol["atol"],
+                                          scene=scene)
+    ts = build_telescopic(p)
+    m = ts.model
+    z0, _ = initial_equilibrium(ts)
+    y0 = np.concatenate([z0, 0 * z0])
+    from sim_core.systems.telescopic.energy_audit import telescopic_energy_check
+    return run_with_partial(
+        lambda: integrate(m, y0, sol["t_end"], sol, progress),
+        lambda t, ys, stats, err: _telescopic_result(ts, t, ys, stats, err, scene),
+        check=lambda res: telescopic_energy_check(ts, res))
+
+
+def _telescopic_result(ts: TelescopicSystem, t, ys, stats, error, scene=None):
+    from sim_core.result import Result
+    m, p = ts.model, ts.params
+    n = m.n_dof
+    N = p.n_booms
+    out = {k: [] for k in ("tip_position", "tip_velocity", "tip_acceleration", "piston_stroke",
+                           "luffing_cylinder_force", "telescopic_cylinder_force",
+                           "contact_point_forces", "inner_contact_s", "outer_contact_s",
+                           "constraint_violation")}
+    from sim_core.physics.contact.friction import region_multipliers, section_reaction
+    basis = m.beams[0].reference_basis
+    left1 = material_point(m, 0, s_fixed=0.0)
+    left2 = material_point(m, 1, s_fixed=0.0)
+    for tk, y in zip(t, ys):
+        z, zd = y[:n], y[n:]
+        zdd, lam = m.accelerations_and_multipliers(tk, z, zd)
+        Q, Qd = m.full_state(tk, z, zd)
+        Qdd = m.lift(tk, zdd, 2)
+        r, J, _, _ = ts.tip(Q)
+        _, Jc, _, _ = ts.tip(Q + 1e-20j * Qd)
+        out["tip_position"].append(r)
+        out["tip_velocity"].append(J @ Qd)
+        out["tip_acceleration"].append(J @ Qdd + (Jc @ Qd).imag / 1e-20)
+        out["piston_stroke"].append(np.linalg.norm(left2(Q)[0] - left1(Q)[0]) - p.stroke0)
+        out["luffing_cylinder_force"].append(lam[ts.rows["luffing_cylinder"]][0])
+        out["telescopic_cylinder_force"].append(lam[ts.rows["telescopic_cylinder"]][0])
+        cpf = []
+        for k in range(N - 1):
+            inner = material_point(m, k, s_index=ts.s2_index[k])
+            outer = material_point(m, k + 1, s_index=ts.s3_index[k + 1])
+            pair = []
+            for name, point in ((f"I_{k + 1}{k + 2}", inner), (f"II_{k + 1}{k + 2}", outer)):
+                f_sec, m_sec = section_reaction(point, Q, *region_multipliers(ts, name, Q, lam),
+                                                basis)
+                pair.append(np.concatenate([f_sec, m_sec]))
+            cpf.append(pair)
+        out["contact_point_forces"].append(cpf)
+        if ts.contact is not None:
+            sols = ts.contact.solve_regions(Q, Qd, lam)
+            if ts.contact.distribution:
+                out.setdefault("slider_contact_forces", []).append(
+                    [sol.normal_force for _, _, _, sol in sols])
+            if p.friction:
+                out.setdefault("friction_coefficient", []).append([mu for _, _, mu, _ in sols])
+        if "rope" in ts.rows:
+            out.setdefault("rope_tension", []).append(-lam[ts.rows["rope"]][0])
+        out["inner_contact_s"].append(Q[ts.s2_index])
+        out["outer_contact_s"].append(Q[ts.s3_index[1:]])
+        out["constraint_violation"].append(np.max(np.abs(m.constraint_violation(tk, z, zd))))
+    outputs = {k: np.array(v, dtype=float) for k, v in out.items()}
+    # the integrated states at the output times (the energy check of the result re-evaluates
+    # the energies from them, simulate.telescopic_energy_check)
+    outputs["state"] = np.asarray(ys, dtype=float)
+    stats["n_dof"] = int(n)
+    return Result(t, outputs, stats, scene if scene is not None else p.summary(), error)

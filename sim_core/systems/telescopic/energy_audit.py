@@ -1,0 +1,192 @@
+"""Energy audit of a telescopic run: where the energy goes, integrated with the motion.
+
+The audit checks "change of kinetic + elastic + gravity energy = drive work - friction
+dissipation, to the solver tolerance".  With the equations of motion of the telescopic model
+(Zhao-Qi-Wang 2024, Eq. 34 virtual power; constraint reactions M z_ddot = F + C^T lambda)
+
+    d/dt (T + U + V + U_rope)  =  P_constraints + P_friction + P_filter                     (*)
+
+holds *exactly* at every state, because every other force is either the gradient of one of
+the energies (elastic U, gravity V, rope strain U_rope, payload weight) or the convective part
+of the inertia forces, which does no work on the material kinetic energy T
+(Q_dot . F_inertia = -1/2 Q_dot^T M_dot Q_dot, tests/beam/test_mass_offset.py).  The terms:
+
+* ``P_constraints = lambda . (g_Q Q_dot)`` over all nonlinear constraint rows.  On the
+  constraint manifold only the rheonomic row does work: the telescopic cylinder's
+  ``P_drive = lambda_cyl * b_dot(t)`` (its prescribed stroke rate); the rest (Baumgarte
+  correction of the velocity drift of the other rows) is reported separately and must be at
+  the level of the integrator's error.
+* ``P_friction = Q_dot . F_friction <= 0`` (Section 8.3: -mu(s_dot) N s_dot on each contact
+  coordinate; mu is odd in s_dot), the friction dissipation.
+* ``P_filter = Q_dot . (F_filter - M_filter Q_ddot)``: the stress filter (second seed Eq. 53,
+  SCENARIOS A7) adds a mass-like term and rate forces; treated here as an applied force, so T
+  stays the material kinetic energy of the booms.  Its integral is the energy the filter takes
+  out (h/2 eps_dot' D eps_dot) or stores in its mass-like term.
+
+``run_energy_audit`` integrates the works W = int P dt as extra states of the same RK45 run, so
+the balance E(t) - E(0) - W_constraints - W_friction - W_filter is a pure integration error
+(it shrinks with rtol: tests/telescopic/test_energy_balance.py).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from sim_core.integrate.checks import ENERGY_FAIL, ENERGY_SUSPECT, verdict
+from sim_core.physics.constraints import constraint_terms
+from sim_core.physics.point_effects import RopeDrive, SliderSeat
+from sim_core.result import Result
+
+WORK_NAMES = ("constraint_work", "drive_work", "friction_work", "filter_work")
+
+
+def rope_energy(rope: RopeDrive, ell: float) -> float:
+    """Strain energy (J) of a tension-only RopeDrive at length ell (m): the integral of its
+    C1-ramp tension law (point_effects.RopeDrive.tension)."""
+    w, k = rope.slack_width, rope.EA / rope.L0
+    d = ell - rope.L0
+    if d <= 0.0:
+        return 0.0
+    if d <= w:
+        return k * d ** 3 / (6.0 * w)
+    return k * w * w / 6.0 + k * (0.5 * (d * d - w * w) - 0.5 * w * (d - w))
+
+
+def mechanical_energy(ts, t: float, z: np.ndarray, zd: np.ndarray) -> float:
+    """Material kinetic + strain + gravity energy of the booms, payload point mass (kinetic and
+    gravity), rope strain energy and the slider seats' strain energy, J.  The stress filter's mass-like term is not included
+    (it is accounted as the filter's work, see the module docstring)."""
+    m, p = ts.model, ts.params
+    Q, Qd = m.full_state(t, z, zd)
+    g = np.array([0.0, 0.0, -p.gravity])
+    en = m.energies(t, Q, Qd, g)
+    E = en["T"] + en["U"] + en["V"]
+    if p.payload > 0:
+        r, J, _, _ = ts.tip(Q)
+        v = J @ Qd
+        E += 0.5 * p.payload * float(v @ v) - p.payload * float(r @ g)
+    for pe in m.point_effects:
+        if isinstance(pe, RopeDrive):
+            E += rope_energy(pe, float(np.real(pe.length(Q)[0])))
+        elif isinstance(pe, SliderSeat):
+            E += pe.energy(Q)
+    return float(np.real(E))
+
+
+def _filter_power(m, filt, t, Q, Qd, Qdd) -> float:
+    """Q_dot . (F_filter - M_filter Q_ddot), W, element by element."""
+    P = 0.0
+    for idx, ctx in m.element_contexts(t, Q, Qd):
+        ne = len(idx)
+        Me, Fe = np.zeros((ne, ne)), np.zeros(ne)
+        filt.element_terms(ctx, Me, Fe)
+        P += float(Qd[idx] @ (Fe - Me @ Qdd[idx]))
+    return P
+
+
+class AuditedSystem:
+    """The telescopic model's first-order system extended by works (J) of WORK_NAMES:
+    y = (z, z_dot, W_1, ..., W_k) for the chosen ``terms`` (default: all four).  Has ``rhs`` so
+    that sim_core.integrate.driver.integrate integrates it like a model.  ``terms=("drive_work",)``
+    costs nothing beyond the model's own right-hand side (lambda is computed there anyway)."""
+
+    def __init__(self, ts, terms=WORK_NAMES):
+        unknown = set(terms) - set(WORK_NAMES)
+        if unknown:
+            raise ValueError(f"terms = {sorted(unknown)}: allowed {WORK_NAMES}")
+        self.ts, self.terms = ts, tuple(terms)
+        m = ts.model
+        self.n = m.n_dof
+        self.filter = next((e for e in m.effects if e.name == "filtering"), None)
+        self.cyl = next(c for c in m.nonlinear if c.name == "telescopic_cylinder")
+        self.cyl_row = ts.rows["telescopic_cylinder"]
+
+    def powers(self, t: float, z: np.ndarray, zd: np.ndarray):
+        """(z_ddot, powers in W of self.terms, in that order)."""
+        m = self.ts.model
+        zdd, lam = m.accelerations_and_multipliers(t, z, zd)
+        Q, Qd = m.full_state(t, z, zd)
+        P = {}
+        if "constraint_work" in self.terms:
+            _, J, _, _ = constraint_terms(m.nonlinear, t, Q, Qd)
+            P["constraint_work"] = float(lam @ (J @ Qd))
+        if "drive_work" in self.terms:
+            b_dot = np.atleast_1d(self.cyl.target(t)[1]) if self.cyl.target is not None else 0.0
+            P["drive_work"] = float(np.sum(lam[self.cyl_row] * b_dot))
+        if "friction_work" in self.terms:
+            P["friction_work"] = (float(Qd @ sum(mf.forces(t, Q, Qd, lam)
+                                                 for mf in m.multiplier_forces))
+                                  if m.multiplier_forces else 0.0)
+        if "filter_work" in self.terms:
+            P["filter_work"] = 0.0
+            if self.filter is not None:
+                Qdd = m.lift(t, zdd, 2)
+                P["filter_work"] = _filter_power(m, self.filter, t, Q, Qd, Qdd)
+        return zdd, [P[k] for k in self.terms]
+
+    def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
+        n = self.n
+        zdd, P = self.powers(t, y[:n], y[n:2 * n])
+        return np.concatenate([y[n:2 * n], zdd, P])
+
+    def integrate(self, y0: np.ndarray, t_end: float, sol: dict, progress=None):
+        """integrate on the extended system from the model state y0 = (z, z_dot) with zero
+        works: returns (t, Y, stats), Y = (z, z_dot, works...)."""
+        from sim_core.integrate.driver import integrate
+        Y0 = np.concatenate([y0, np.zeros(len(self.terms))])
+        return integrate(self, Y0, t_end, sol, progress)
+
+
+def run_energy_audit(ts, y0: np.ndarray, t_end: float, rtol: float = 1e-6, atol: float = 1e-7,
+                     n_output: int = 21, terms=WORK_NAMES):
+    """Integrate ts from y0 = (z, z_dot) with the works as extra states; returns a dict of
+    arrays at the output times: ``t`` (s), ``energy`` (J, mechanical_energy), the works of
+    ``terms`` (J, from 0), with all four terms ``residual`` = E - E(0) - W_constraints -
+    W_friction - W_filter (J), and the RK45 ``stats``."""
+    sysa = AuditedSystem(ts, terms)
+    n = sysa.n
+    t, Y, stats = sysa.integrate(y0, t_end, {"rtol": rtol, "atol": atol, "n_output": n_output})
+    E = np.array([mechanical_energy(ts, tk, y[:n], y[n:2 * n]) for tk, y in zip(t, Y)])
+    out = {"t": t, "energy": E, "stats": stats}
+    for k, name in enumerate(sysa.terms):
+        out[name] = Y[:, 2 * n + k]
+    if set(sysa.terms) == set(WORK_NAMES):
+        out["residual"] = (E - E[0] - out["constraint_work"] - out["friction_work"]
+                           - out["filter_work"])
+    return out
+
+
+def telescopic_energy_check(ts, res: Result) -> dict:
+    """Energy balance of a telescopic run's result (``res["state"]``: the integrated states at
+    the output times): E = booms' T + U + V, payload and rope strain energy
+    (:func:`sim_core.systems.telescopic.energy_audit.mechanical_energy`) against the telescopic cylinder's work
+    W = int lambda_cyl b'(t) dt (its prescribed stroke rate; trapezoidal rule over the outputs,
+    the power from one right-hand side per output).  Friction and the stress filter only take
+    energy out and the other constraint rows do no work on the constraint manifold
+    (:mod:`sim_core.systems.telescopic.energy_audit`), so only growth is checked: max_t (E - E(0) - W) over the
+    exchanged energy ptp(E) + ptp(W), against ENERGY_SUSPECT and ENERGY_FAIL plus the
+    quadrature error of W.  Empty where the result has no states."""
+    if not len(res.t) or "state" not in res:
+        return {}
+    ts_, Y = np.asarray(res.t, dtype=float), np.asarray(res["state"])
+    audit = AuditedSystem(ts, ("drive_work",))
+    n = audit.n
+    E = np.array([mechanical_energy(ts, t, y[:n], y[n:2 * n]) for t, y in zip(ts_, Y)])
+    P = np.array([audit.powers(t, y[:n], y[n:2 * n])[1][0] for t, y in zip(ts_, Y)])
+    W = np.concatenate([[0.0], np.cumsum(0.5 * (P[1:] + P[:-1]) * np.diff(ts_))])
+    quad = 0.0
+    if len(ts_) >= 3:
+        tc, Pc = ts_[::2], P[::2]
+        Wc = np.concatenate([[0.0], np.cumsum(0.5 * (Pc[1:] + Pc[:-1]) * np.diff(tc))])
+        quad = float(np.max(np.abs(Wc - W[::2])))
+    scale = max(float(np.ptp(E) + np.ptp(W)), 1e-12 * float(np.max(np.abs(E))), 1e-300)
+    value = float(np.max(E - E[0] - W)) / scale
+    if not np.isfinite(value):
+        value = math.inf
+    q = quad / scale
+    return {"energy_balance": verdict(
+        value, ENERGY_SUSPECT + q, ENERGY_FAIL + q,
+        f"energy growth / exchanged energy (E = T + U + V + payload + ropes, W: drive; E_x = "
+        f"{scale:.3g} J, quadrature {q:.2g})")}

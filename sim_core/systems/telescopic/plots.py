@@ -1,0 +1,120 @@
+"""Figures of a telescopic result: the rigid-limit tip comparison, contact-point forces and
+slider loads of Zhao-Qi-Wang 2024 Section 9."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from sim_core.figures import save_figure
+from sim_core.result import Result
+
+
+def _luffing_angle(result: Result) -> float | None:
+    sc = result.scene
+    for table in ("booms", "params"):
+        if isinstance(sc.get(table), dict) and "luffing_angle_deg" in sc[table]:
+            return float(sc[table]["luffing_angle_deg"])
+    return None
+
+
+def _times(t: np.ndarray, wanted) -> list[int]:
+    """Output indices nearest to the wanted times inside the run (no duplicates)."""
+    idx = []
+    for w in wanted:
+        if t[0] <= w <= t[-1]:
+            i = int(np.argmin(np.abs(t - w)))
+            if i not in idx:
+                idx.append(i)
+    return idx
+
+
+def plot_telescopic(result: Result, out: str | Path, slider_times=None) -> list[Path]:
+    """The telescopic figures of Zhao-Qi-Wang 2024 Section 9:
+
+    * ``tip_rigid_limit.png`` (Figs. 14-17): tip X and Z and their rates against the rigid-boom
+      kinematics tip_0 + 2 s(t) (cos theta, sin theta) (Eqs. 74-76: boom 3 moves twice the
+      piston stroke s), and the difference (the flexible deflection and the rope stretch);
+    * ``contact_point_forces.png`` (Figs. 22-25): force and moment components (section frame:
+      axial s, lateral t, vertical b) at the inner and outer contact points of every pair;
+    * ``slider_contact_forces.png`` (Fig. 26): normal force of every slider spring of every
+      region at chosen times (default: t_end / 4, t_end / 2, 0.8 t_end = 16 s of the paper's
+      20 s, t_end), springs numbered arc by arc as in ``sim_core.physics.contact``.
+    """
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out = Path(out)
+    t = result.t
+    paths = []
+    theta = _luffing_angle(result)
+    if theta is not None and "tip_position" in result and "piston_stroke" in result:
+        e = np.array([np.cos(np.radians(theta)), np.sin(np.radians(theta))])
+        tip = result["tip_position"][:, [0, 2]]
+        vel = result["tip_velocity"][:, [0, 2]]
+        s = result["piston_stroke"]
+        rigid = tip[0] + 2.0 * s[:, None] * e
+        rigid_rate = 2.0 * np.gradient(s, t)[:, None] * e
+        fig, axes = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
+        for c, lab in enumerate("XZ"):
+            axes[0].plot(t, tip[:, c], label=f"{lab} flexible")
+            axes[0].plot(t, rigid[:, c], "--", label=f"{lab} rigid limit")
+            axes[1].plot(t, vel[:, c], label=f"d{lab}/dt flexible")
+            axes[1].plot(t, rigid_rate[:, c], "--", label=f"d{lab}/dt rigid limit")
+            axes[2].plot(t, 1e3 * (tip[:, c] - rigid[:, c]), label=f"{lab} - rigid")
+        axes[0].set_ylabel("tip [m]")
+        axes[1].set_ylabel("tip rate [m/s]")
+        axes[2].set_ylabel("flexible - rigid [mm]")
+        axes[2].set_xlabel("t [s]")
+        for ax in axes:
+            ax.grid(alpha=0.3)
+            ax.legend(loc="best", fontsize=7)
+        fig.suptitle(f"tip (top centre of the innermost boom) vs rigid-boom kinematics, "
+                     f"luffing {theta:g} deg")
+        fig.tight_layout()
+        paths.append(save_figure(fig, out / "tip_rigid_limit.png"))
+        plt.close(fig)
+    if "contact_point_forces" in result:
+        cpf = result["contact_point_forces"]            # (n, pairs, 2, 6)
+        fig, axes = plt.subplots(2, 2, figsize=(11, 7), sharex=True)
+        comps = ("s", "t", "b")
+        for k in range(cpf.shape[1]):
+            for j, where in enumerate((f"inner, boom {k + 1}", f"outer, boom {k + 2}")):
+                for c in range(3):
+                    axes[0, j].plot(t, cpf[:, k, j, c] / 1e3, label=f"f_{comps[c]} {where}")
+                    axes[1, j].plot(t, cpf[:, k, j, 3 + c] / 1e3, label=f"m_{comps[c]} {where}")
+        for j, title in enumerate(("inner contact points (region I)",
+                                   "outer contact points (region II)")):
+            axes[0, j].set_title(title, fontsize=10)
+            axes[0, j].set_ylabel("force [kN]")
+            axes[1, j].set_ylabel("moment [kN m]")
+            axes[1, j].set_xlabel("t [s]")
+        for ax in axes.ravel():
+            ax.grid(alpha=0.3)
+            ax.legend(loc="best", fontsize=6, ncol=2)
+        fig.suptitle("constraint reactions at the contact points (section frame)")
+        fig.tight_layout()
+        paths.append(save_figure(fig, out / "contact_point_forces.png"))
+        plt.close(fig)
+    if "slider_contact_forces" in result:
+        sf = result["slider_contact_forces"]            # (n, regions, springs)
+        wanted = slider_times if slider_times is not None else \
+            [t[-1] / 4, t[-1] / 2, 0.8 * t[-1], t[-1]]
+        idx = _times(t, wanted)
+        names = ["I_12", "II_12", "I_23", "II_23"][:sf.shape[1]]
+        fig, axes = plt.subplots(len(names), 1, figsize=(9, 2.2 * len(names)), sharex=True)
+        axes = np.atleast_1d(axes)
+        for r, (ax, name) in enumerate(zip(axes, names)):
+            for i in idx:
+                ax.plot(np.arange(1, sf.shape[2] + 1), sf[i, r] / 1e3, label=f"t = {t[i]:.3g} s")
+            ax.set_ylabel(f"{name} [kN]")
+            ax.grid(alpha=0.3)
+            ax.legend(loc="best", fontsize=7)
+        axes[-1].set_xlabel("spring (arc by arc)")
+        fig.suptitle("normal force of the slider springs")
+        fig.tight_layout()
+        paths.append(save_figure(fig, out / "slider_contact_forces.png"))
+        plt.close(fig)
+    return paths
