@@ -13,6 +13,7 @@ import numpy as np
 from scipy.integrate import BDF, RK45
 
 from sim_core.errors import ElementEvaluationError, SimulationError, StalledIntegration
+from sim_core.integrate import _generalized_alpha_numba as ga_numba
 from sim_core.integrate.bdf import (
     BDF_NEWTON_ITERATIONS,
     RefreshedJacobian,
@@ -20,8 +21,11 @@ from sim_core.integrate.bdf import (
     bdf_newton_limit,
 )
 from sim_core.integrate.checks import check_result, result_checks
+from sim_core.integrate.generalized_alpha import GeneralizedAlphaParameters, integrate_generalized_alpha
 from sim_core.integrate.switching import MethodSwitch
 from sim_core.model.model import Model
+from sim_core.model.state_jacobian import REL_STEP, state_jacobian
+from sim_core.physics import _effects_numba as ec
 from sim_core.scene.fields import SOLVER_METHODS
 
 
@@ -73,7 +77,6 @@ class _CountingRHS:
 
     def jacobian(self, t, y):
         """Structured Jacobian (:mod:`sim_core.model.state_jacobian`) for BDF, its cost counted."""
-        from sim_core.model.state_jacobian import state_jacobian
         try:
             with np.errstate(over="raise", divide="raise", invalid="raise", under="ignore"):
                 J, cost = state_jacobian(self.model, t, y, return_cost=True)
@@ -193,6 +196,9 @@ def integrate(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
       state_jacobian`, ~1/6 of the cost at the paper's discretisation), or
       ``"finite_difference"``: scipy's differences of the whole right-hand side (one model.rhs
       per state per Jacobian);
+    * ``"generalized_alpha"``: the implicit second-order method at the fixed step
+      ``sol["h"]`` (:func:`integrate_alpha`) — for beam models without friction switching,
+      where the explicit step is stability-limited by the stiffest bending mode;
     * ``"auto"``: RK45 and BDF alternate as :class:`MethodSwitch` decides (RK45 -> BDF when
       :class:`StiffnessDetector` finds the step stability-limited, back to RK45 after a
       stretch whose length adapts to which method was cheaper); the statistics record the
@@ -210,6 +216,8 @@ def integrate(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
     method = sol.get("method", "RK45")
     if method not in SOLVER_METHODS:
         raise ValueError(f"solver.method = {method!r}: must be one of {SOLVER_METHODS}")
+    if method == "generalized_alpha":
+        return integrate_alpha(model, y0, t_end, sol, progress)
     t_eval = np.linspace(0.0, t_end, sol["n_output"])
     rhs = _CountingRHS(model)
     kwargs = {"max_step": sol["max_step"]} if "max_step" in sol else {}
@@ -346,3 +354,119 @@ def run_with_partial(integrate, collect, check=None):
     if check is not None:
         checks.update(check(res))
     return check_result(res, checks)
+
+
+class StructuredTangent:
+    """A model as the SecondOrderSystem of :func:`integrate_generalized_alpha` with its tangent
+    from the structured state Jacobian (:func:`sim_core.model.state_jacobian.state_jacobian`):
+    dz_ddot/dz = -M^-1 K and dz_ddot/dz_dot = -M^-1 C, so K = -M J_zz and C = -M J_zv."""
+
+    def __init__(self, model):
+        self.model = model
+        self.n = model.n_dof
+
+    def mass_and_force(self, t, q, v):
+        return self.model.mass_and_force(t, q, v)
+
+    def tangent(self, t, q, v):
+        n = self.model.n_dof
+        J = state_jacobian(self.model, t, np.concatenate([q, v]))
+        M, _ = self.model.mass_and_force(t, q, v)
+        return -M @ J[n:, :n], -M @ J[n:, n:]
+
+
+def integrate_alpha(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
+    """Generalized-alpha (Chung & Hulbert 1993; Arnold & Bruels 2007) from y0 = (z0, z_dot0)
+    at t = 0 with outputs at ``sol["n_output"]`` equally spaced times; the contract of
+    :func:`integrate`.  Solver keys: ``h`` (s, the largest step; each output interval is cut
+    into equal steps of at most h), ``rho_inf`` (spectral radius at infinity, [0, 1]) and
+    ``newton_atol`` (m, the position error the Newton iteration may leave per step).
+
+    Where :meth:`sim_core.model.model.Model.element_loop_plan` covers the model, the steps of
+    each output interval run in one compiled call
+    (:func:`sim_core.integrate._generalized_alpha_numba.run_steps`) with the tangent formed once
+    and reused across steps; otherwise the numpy method
+    (:func:`integrate_generalized_alpha`) with the structured tangent, at the same fixed step.
+    The wall budget ``max_wall_s`` and the progress callback are served between output
+    intervals; a failed Newton iteration raises SimulationError with the outputs so far."""
+    n = model.n_dof
+    t_eval = np.linspace(0.0, t_end, sol["n_output"])
+    h, rho = float(sol["h"]), float(sol.get("rho_inf", 0.9))
+    newton_atol = float(sol.get("newton_atol", 1e-8))
+    budget = sol.get("max_wall_s")
+    wall0 = time.perf_counter()
+    p = GeneralizedAlphaParameters.from_rho_inf(rho)
+    plan = model.element_loop_plan() if isinstance(model, Model) else None
+    ys = [np.array(y0, dtype=float)]
+    counts = np.zeros(6, dtype=np.int64)       # steps, residuals, Newton its, tangents, LUs, fails
+    h_used = []
+
+    def stats():
+        wall = time.perf_counter() - wall0
+        return {"wall_time_s": wall, "n_steps": int(counts[0]), "n_rhs": int(counts[1]),
+                "n_newton_iterations": int(counts[2]), "n_jac": int(counts[3]),
+                "n_lu": int(counts[4]), "n_newton_failures": int(counts[5]),
+                "min_step_s": min(h_used) if h_used else h, "max_step_s": max(h_used) if h_used else h,
+                "method": "generalized_alpha", "rho_inf": rho, "h": h,
+                "newton_atol": newton_atol, "compiled": plan is not None,
+                "real_time_factor": float(t_eval[len(ys) - 1]) / max(wall, 1e-12)}
+
+    def fail(t, reason, step):
+        exc = SimulationError(t, reason, step=step, last_state=ys[-1])
+        exc.partial = (t_eval[:len(ys)], np.array(ys), stats())
+        return exc
+
+    if plan is None:
+        try:
+            r = integrate_generalized_alpha(StructuredTangent(model), (0.0, t_end), y0[:n],
+                                            y0[n:], h=h, rho_inf=rho, atol=newton_atol,
+                                            t_eval=t_eval)
+        except SimulationError as exc:
+            exc.partial = (t_eval[:1], np.array(ys), stats())
+            raise
+        st = r.stats
+        counts[:] = (st.n_steps, st.n_force_evaluations, st.n_newton_iterations,
+                     st.n_jacobian_evaluations, st.n_lu, st.n_newton_failures)
+        h_used.append(h)
+        ys = list(np.hstack([r.q, r.v]))
+        if progress is not None:
+            progress(t_end, time.perf_counter() - wall0)
+        return t_eval, np.array(ys), stats()
+
+    q, v = np.array(y0[:n], dtype=float), np.array(y0[n:], dtype=float)
+    M0, _, _, f0 = ga_numba.mass_tangent(*_lifted(plan, q, v, np.zeros(n)), REL_STEP, plan.eidx,
+                                         plan.red, plan.sg, n, *plan.kernel_args, ec.NO_ACC)
+    qdd = np.linalg.solve(M0, f0)              # z_ddot(0) = M^-1 f (constant constraints)
+    a = qdd.copy()                             # a_0 = z_ddot(0) (Arnold & Bruels 2007)
+    Sinv, qdd_prev, carry = np.empty((n, n)), qdd.copy(), np.array([0.0, 1.0])
+    out = np.empty((2, n)), np.empty((2, n)), np.empty((2, n))
+    for k in range(1, len(t_eval)):
+        span = t_eval[k] - t_eval[k - 1]
+        m = max(1, math.ceil(span / h * (1.0 - 1e-12)))
+        hh = span / m
+        h_used.append(hh)
+        code, done = ga_numba.run_steps(
+            q, v, qdd, a, m, hh, p.alpha_m, p.alpha_f, p.beta, p.gamma, newton_atol, 8, 0.3,
+            REL_STEP, m, 0.0, plan.Qp, plan.rows, plan.sgn, plan.eidx, plan.red, plan.sg,
+            *plan.kernel_args, ec.NO_ACC, *out, counts, Sinv, qdd_prev, carry)
+        if code != ga_numba.OK or not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
+            raise fail(float(t_eval[k - 1] + done * hh), "generalized-alpha: the Newton "
+                       "iteration failed with a fresh tangent (or the state is not finite); "
+                       "reduce solver.h", hh)
+        ys.append(np.concatenate([q, v]))
+        if progress is not None:
+            progress(float(t_eval[k]), time.perf_counter() - wall0)
+        if budget is not None and time.perf_counter() - wall0 > budget and k < len(t_eval) - 1:
+            raise fail(float(t_eval[k]), f"wall-clock budget solver.max_wall_s = {budget:g} s "
+                       "exhausted", hh)
+    return t_eval, np.array(ys), stats()
+
+
+def _lifted(plan, z, zd, zdd):
+    """Full (Q, Q_dot, Q_ddot) of reduced values through the plan's selection."""
+    N = len(plan.Qp)
+    Q, Qd, Qdd = np.empty(N), np.empty(N), np.empty(N)
+    ga_numba.lift(np.asarray(z, float), plan.Qp, plan.rows, plan.sgn, Q)
+    ga_numba.lift(np.asarray(zd, float), np.zeros(N), plan.rows, plan.sgn, Qd)
+    ga_numba.lift(np.asarray(zdd, float), np.zeros(N), plan.rows, plan.sgn, Qdd)
+    return Q, Qd, Qdd

@@ -38,6 +38,23 @@ Scalar = Callable[[float], float]
 
 
 @dataclass
+class ElementLoopPlan:
+    """What :meth:`Model.element_loop_plan` hands a compiled loop: ``n`` reduced coordinates,
+    the particular solution ``Qp`` (N,), the selection ``rows``/``sgn`` (Q = Qp + P z), the
+    element coordinate map ``eidx`` (E, nq), the reduced index ``red`` (-1 where fixed) and sign
+    ``sg`` of every full coordinate, and the element kernel's arguments ``kernel_args``."""
+
+    n: int
+    Qp: np.ndarray
+    rows: np.ndarray
+    sgn: np.ndarray
+    eidx: np.ndarray
+    red: np.ndarray
+    sg: np.ndarray
+    kernel_args: tuple
+
+
+@dataclass
 class Model:
     """A set of beams with the effects and boundary conditions of a scene."""
 
@@ -463,6 +480,38 @@ class Model:
                 raise workers.evaluation_error(exc, t) from exc
             return workers.checked_batch(out)
         return wait
+
+    def element_loop_plan(self) -> "ElementLoopPlan | None":
+        """The arrays a compiled time-step loop needs to evaluate this model without Python
+        (:mod:`sim_core.integrate._generalized_alpha_numba`): the element batch's tables and
+        effect arguments, the element -> coordinate map and the reduction Q = Q_p + P z with P a
+        signed selection.  None where the model has anything outside the compiled element batch:
+        point loads or point effects, nonlinear constraints, multiplier forces, extra
+        coordinates, time-dependent or non-selecting linear constraints, effects the kernel does
+        not cover."""
+        if (not element_compiled.AVAILABLE or self.point_loads or self.point_effects
+                or self.nonlinear or self.multiplier_forces or self._sel is None or self.n_extra
+                or not all(c.constant for c in self.constraints)):
+            return None
+        Q0 = np.array(self._particular(0.0, 0), dtype=float)
+        plan = self._element_batch_plan(Q0, np.zeros_like(Q0))
+        if plan is None:
+            return None
+        batch, kw = plan
+        eidx = np.ascontiguousarray(self._element_idx, dtype=np.int64)
+        if np.setdiff1d(np.arange(self.n_coords), eidx.ravel()).size:
+            return None                           # a coordinate outside every element
+        rows, sgn, _ = self._sel
+        red = np.full(self.n_coords, -1, dtype=np.int64)
+        red[rows] = np.arange(len(rows))
+        sg = np.zeros(self.n_coords)
+        sg[rows] = sgn
+        grav = np.ascontiguousarray(kw["g"], dtype=float)
+        args = batch.element_arguments() + (float(kw["h"]), grav, batch.inertia,
+                                            batch.elasticity, bool(np.any(grav != 0.0)),
+                                            float(COMPLEX_STEP))
+        return ElementLoopPlan(int(self.n_dof), Q0, np.ascontiguousarray(rows, dtype=np.int64),
+                               np.ascontiguousarray(sgn, dtype=float), eidx, red, sg, args)
 
     def _element_batch_plan(self, Q, Qd):
         """(ElementBatch, effect arguments of this call) or None where the batch does not cover

@@ -47,6 +47,7 @@ from sim_core.physics.beam import _cardan_numba as cardan_compiled
 from sim_core.physics.complex_step import COMPLEX_STEP
 
 _NO_ACC = np.zeros(0)
+NO_ACC = _NO_ACC             # "no accelerations" for the kernels' qdde argument
 
 
 def _centre_line(qe, X, Y, n, basis):
@@ -582,6 +583,10 @@ if AVAILABLE:
     _compiled_mass_force = _jit(_mass_force)
     _compiled_mass_force_batch = _jit(_mass_force_batch)
     _compiled_differences_batch = _jit(_differences_batch)
+    # the kernels called from other compiled loops (integrate/_generalized_alpha_numba.py)
+    mass_force_kernel = _compiled_mass_force
+    mass_force_batch_kernel = _compiled_mass_force_batch
+    differences_batch_kernel = _compiled_differences_batch
 
 
 def element_mass_force(el, qe, qde, rhoA, Jrot, D, h=0.0, g=None, inertia=True,

@@ -113,21 +113,30 @@ def choice(table: dict, key: str, where: str, allowed: tuple[str, ...], default=
 
 # -- the solver table (all scene kinds) ----------------------------------------------------------
 
-_SOLVER = {"t_end", "method", "jacobian", "rtol", "atol", "n_output", "max_step", "max_wall_s"}
-SOLVER_METHODS = ("RK45", "BDF", "auto")
+_SOLVER = {"t_end", "method", "jacobian", "rtol", "atol", "n_output", "max_step", "max_wall_s",
+           "h", "rho_inf", "newton_atol"}
+SOLVER_METHODS = ("RK45", "BDF", "auto", "generalized_alpha")
 JACOBIANS = ("structured", "finite_difference")
+_ALPHA_KEYS = ("h", "rho_inf", "newton_atol")
+# the methods with error control, the stiffness switch and the stall monitor: the only ones for
+# systems whose forces switch (friction stick-slip, contact) or that hold nonlinear constraints
+ERROR_CONTROLLED = ("RK45", "BDF", "auto")
 
 
-def solver_table(s: dict, t_end=None, atol: float = 1e-8, n_output: int = 201) -> dict:
+def solver_table(s: dict, t_end=None, atol: float = 1e-8, n_output: int = 201,
+                 methods: tuple[str, ...] = SOLVER_METHODS) -> dict:
     """The validated [solver] table shared by every scene kind: t_end s (> 0), method
-    (``SOLVER_METHODS``, see :func:`sim_core.integrate.driver.integrate`), jacobian of the implicit
+    (``methods``, see :func:`sim_core.integrate.driver.integrate`), jacobian of the implicit
     method (``JACOBIANS``: "structured" = :mod:`sim_core.model.state_jacobian`, "finite_difference" =
     scipy's differences of the whole right-hand side), rtol (0, 1), atol (> 0),
     n_output (>= 2), optional max_step s (> 0) and max_wall_s s (> 0, wall-clock budget).
+    With method "generalized_alpha": h s (> 0, required: the largest fixed step), rho_inf
+    (spectral radius at infinity, [0, 1], default 0.9) and newton_atol m (> 0, default 1e-8:
+    the position error the Newton iteration may leave per step).
     The arguments are the scene kind's defaults (t_end None: required)."""
     check_keys(s, _SOLVER, "solver")
     out = {"t_end": number(s, "t_end", "solver", t_end, lo=0.0, lo_open=True),
-           "method": choice(s, "method", "solver", SOLVER_METHODS, "RK45"),
+           "method": choice(s, "method", "solver", methods, "RK45"),
            "jacobian": choice(s, "jacobian", "solver", JACOBIANS, "structured"),
            "rtol": number(s, "rtol", "solver", 1e-6, lo=0.0, hi=1.0, lo_open=True, hi_open=True),
            "atol": number(s, "atol", "solver", atol, lo=0.0, lo_open=True),
@@ -135,4 +144,13 @@ def solver_table(s: dict, t_end=None, atol: float = 1e-8, n_output: int = 201) -
     for key in ("max_step", "max_wall_s"):
         if key in s:
             out[key] = number(s, key, "solver", lo=0.0, lo_open=True)
+    if out["method"] == "generalized_alpha":
+        out["h"] = number(s, "h", "solver", lo=0.0, hi=out["t_end"], lo_open=True)
+        out["rho_inf"] = number(s, "rho_inf", "solver", 0.9, lo=0.0, hi=1.0)
+        out["newton_atol"] = number(s, "newton_atol", "solver", 1e-8, lo=0.0, lo_open=True)
+    else:
+        for key in _ALPHA_KEYS:
+            if key in s:
+                raise SceneError(f"solver.{key} = {s[key]!r}: only method = 'generalized_alpha' "
+                                 f"has a {key} (method is {out['method']!r})")
     return out

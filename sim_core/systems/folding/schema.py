@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from sim_core.errors import SceneError
-from sim_core.scene.fields import boolean, check_keys, number, solver_table
+from sim_core.scene.fields import ERROR_CONTROLLED, boolean, check_keys, number, solver_table
 from sim_core.systems.folding.build import FoldingParams, cylinder_lengths
 
 _TOP = {"kind", "name", "description", "notes", "solver", "booms", "cylinders", "drive", "rest",
@@ -38,7 +38,8 @@ def validate_folding(raw: dict, source: str) -> dict[str, Any]:
     check_keys(raw, _TOP, "scene")
     sc: dict[str, Any] = {"kind": "folding", "name": str(raw.get("name", "folding")),
                           "description": str(raw.get("description", "")), "source": source}
-    sc["solver"] = solver_table(raw.get("solver", {}), t_end=45.0, n_output=451)
+    sc["solver"] = solver_table(raw.get("solver", {}), t_end=45.0, n_output=451,
+                                methods=ERROR_CONTROLLED)
     b = raw.get("booms", {})
     check_keys(b, {"length", "radius", "mass_per_length", "E", "nu", "n_nodes", "n_gauss"}, "booms")
     sc["booms"] = {"length": number(b, "length", "booms", 12.0, lo=1.0, lo_open=True),

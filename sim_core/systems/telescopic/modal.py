@@ -62,8 +62,8 @@ import numpy as np
 import scipy.linalg as sla
 
 from sim_core.result import atomic_write_bytes
-from sim_core.systems.telescopic.params import TelescopicParams
 from sim_core.systems.telescopic.build import build_telescopic, initial_equilibrium
+from sim_core.systems.telescopic.params import TelescopicParams
 
 DATA = Path(__file__).parent / "data" / "modal_telescopic.npz"
 N_MODES_TABLE = 4

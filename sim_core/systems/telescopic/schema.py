@@ -54,7 +54,7 @@ from __future__ import annotations
 from typing import Any
 
 from sim_core.errors import SceneError
-from sim_core.scene.fields import boolean, check_keys, choice, number, solver_table
+from sim_core.scene.fields import ERROR_CONTROLLED, boolean, check_keys, choice, number, solver_table
 from sim_core.systems.telescopic.params import TelescopicParams
 
 _TOP = {"kind", "name", "description", "solver", "booms", "drive", "payload", "ropes", "effects",
@@ -65,7 +65,8 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
     check_keys(raw, _TOP, "scene")
     sc: dict[str, Any] = {"kind": "telescopic", "name": str(raw.get("name", "telescopic")),
                           "description": str(raw.get("description", "")), "source": source}
-    sc["solver"] = solver_table(raw.get("solver", {}), t_end=20.0, atol=1e-7)
+    sc["solver"] = solver_table(raw.get("solver", {}), t_end=20.0, atol=1e-7,
+                                methods=ERROR_CONTROLLED)
     b = raw.get("booms", {})
     check_keys(b, {"count", "length", "luffing_angle_deg", "stroke0", "L_h", "E", "rho",
                    "n_nodes", "n_gauss"}, "booms")
