@@ -5,15 +5,31 @@ boom 3's tip) extends (or retracts) its telescopic cylinder from a start to a ta
 length L_s.  The agent commands the cylinder acceleration; the flexible booms respond.  The goal
 is to reach the target quickly while leaving as little tip vibration as possible.
 
+Boom count (``booms``)
+----------------------
+* ``3`` (default): the paper's crane; the tip moves 2 m per m of L_s.
+* ``5``: five sections, the paper's three booms inside two larger ones of the same family
+  (``sim_core.systems.telescopic.params.crane_sections``; scenes ``telescopic_extraction_5`` /
+  ``telescopic_retraction_5``), synchronized drive: cylinders on stages 1-2 and 3-4 and rope
+  units moving booms 3 and 5, every stage moving with the same L_s, so the tip moves 4 m per m
+  of L_s (up to 2 m/s at v_max = 0.5 m/s) and the boom is 17-43 m long.  Payload 5-15 t
+  (default 10 t); first in-plane bending mode 0.24-1.77 Hz over the tables (0.615 Hz at
+  L_s = 5 m, 10 t, 60 deg; three booms at 25 t: 0.71 Hz).
+Other counts raise ValueError: modal tables are shipped for 3 and 5 sections
+(``sim_core.systems.telescopic.modal.TABLE_BOOMS``).  The spaces and the reward's form are the
+same for both; the plant, the default payload, the payload range and the deflection scales of
+the reward and the success test (10 times larger for five booms, see Reward) differ.
+
 Dynamics (``fidelity``)
 -----------------------
 * ``"rl"`` (default): the stroke-parametric modal reduced-order model
   ``sim_core.systems.telescopic.modal`` (in-plane modes of the full sim_core model, linearised about the
-  static equilibrium at each L_s; tables shipped in sim_core/data).  ~2e4 env steps/s on one
+  static equilibrium at each L_s; tables shipped in sim_core/systems/telescopic/data).  ~2e4 env steps/s on one
   core, ~900 times real time (benchmarks/env_speed.md).
 * ``"paper"``: the full sim_core model (``sim_core.systems.telescopic.build``, frictionless by default,
-  ``paper_n_nodes`` nodes per spline element, default 3) advanced step by step: for each control
-  step the telescopic-cylinder constraint target is replaced by the env's stroke kinematics and
+  ``paper_n_nodes`` nodes per spline element, default 3; ``booms`` sections, synchronized
+  drive) advanced step by step: for each control step the targets of the telescopic cylinders
+  (every cylinder of the synchronized drive) are replaced by the env's stroke kinematics and
   the model is integrated with ``sim_core.integrate.driver.integrate`` (rtol 1e-6, atol 1e-7) from
   the current state.  Slow: a real-time factor of order 1 or less (benchmarks/env_speed.md);
   for checking policies, not for training.
@@ -53,16 +69,18 @@ Observation space
  10   luffing angle, normalised (observe_parameters)    [-1, 1]
 ====  ===============================================  ==================
 
-The deflection is the tip position (boom 3, s = 10 m) minus the static-equilibrium tip of the
-same model at the current L_s (tables of the full model), i.e. the vibration plus the
-quasi-static inertial deflection.  With ``fidelity="paper"`` the reference is the full model's
-own equilibrium tip at reset moved by the tables' static tip change (the tables interpolate
-across the retraction rope's slack/taut switch near L_s = 2 m, ~1 mm off there).  Deflections are mm-scale: normalise observations
-(e.g. VecNormalize) for learning.  A deflection outside its bounds counts as divergence.
+The deflection is the tip position (innermost boom N = ``booms``, s = 10 m) minus the
+static-equilibrium tip of the same model at the current L_s (tables of the full model), i.e. the
+vibration plus the quasi-static inertial deflection.  With ``fidelity="paper"`` the reference is
+the full model's own equilibrium tip at reset moved by the tables' static tip change (the tables
+interpolate across the retraction rope's slack/taut switch near L_s = 2 m, ~1 mm off there).
+Deflections are mm-scale (cm with ``booms=5``): normalise observations (e.g. VecNormalize)
+for learning.  A deflection outside its bounds counts as divergence.
 
 ``observe_parameters=True`` appends the episode's payload and luffing angle, mapped linearly
-from the modal tables' range (``sim_core.systems.telescopic.modal.allowed_ranges``: 20-30 t, 45-75 deg)
-to [-1, 1] (x_n = (2 x - lo - hi) / (hi - lo); 25 t and 60 deg give 0).  With
+from the modal tables' range (``sim_core.systems.telescopic.modal.allowed_ranges``: 20-30 t with
+3 booms, 5-15 t with 5; 45-75 deg) to [-1, 1] (x_n = (2 x - lo - hi) / (hi - lo); the middle
+payload and 60 deg give 0).  With
 ``payload_range`` / ``angle_range`` the plant changes from episode to episode (first bending
 frequency, quasi-static deflection); without these two entries a policy cannot tell which plant
 it drives.  Default False: the 9-entry observation of the registered ids.
@@ -85,6 +103,15 @@ PPO agent learned to stay at the start (return ~ -60 over 30 s) because the pape
 schedule, which pays ~3 mm of tip deflection while decelerating, scores ~ -76 (agents/README
 notes).
 
+With ``booms=5`` the deflection scales d_ref, dv_ref (and the success tolerances below) are
+10 times larger by default (1 cm, 0.1 m/s): the same stroke history deflects the
+five-section tip about 9 times as much (the paper's cubic schedule: peak 30.4 mm at 10 t
+against 3.4 mm for three booms at 25 t).  With the three-boom scales the schedule would score
+-3549 unscaled, ten times worse than standing still (-330); with the scaled ones -144.4
+(extraction; retraction -69.4 and successful), like the -147.6 of three booms, and the
+weights keep their meaning for both counts.  ``d_ref``, ``dv_ref`` (m, m/s) are constructor
+arguments (default None: the scale of the boom count).
+
 ``reward_scale`` multiplies every term and leaves their ratios, and so the ranking of any two
 policies, unchanged.  Unscaled (``reward_scale=1``) a 30 s episode of uniform random actions
 scores -5e3 to -3e4 (the quadratic vibration terms of a white-noise jerk), standing still
@@ -97,26 +124,28 @@ before scaling.
 Start state
 -----------
 Static equilibrium at rest at L_start (extraction: 2 m -> target 8 m; retraction: 8 m -> 2 m,
-the paper's strokes), q = 0.  ``reset(seed=..., options=...)``: options may set ``payload`` (kg),
-``luffing_angle_deg`` (deg), ``stroke_start``, ``stroke_target`` (m).  Domain randomisation:
-``payload_range=(lo, hi)`` / ``angle_range=(lo, hi)`` draw them uniformly from
-``self.np_random`` at every reset (seeded through reset(seed)).  The ROM tables cover
-payload 20-30 t and luffing angles 45-75 deg (tabulated at 45, 60, 75 deg and interpolated
-linearly between them: first bending frequency within 0.7 % of the full model's at 52.5 deg,
-tests/env/test_modal.py; ``sim_core.systems.telescopic.modal.allowed_ranges``); values outside raise
-ValueError.
+the paper's strokes, for both boom counts), q = 0; payload 25 t (``booms=3``) or 10 t
+(``booms=5``) unless ``payload`` is given.  ``reset(seed=..., options=...)``: options may set
+``payload`` (kg), ``luffing_angle_deg`` (deg), ``stroke_start``, ``stroke_target`` (m).  Domain
+randomisation: ``payload_range=(lo, hi)`` / ``angle_range=(lo, hi)`` draw them uniformly from
+``self.np_random`` at every reset (seeded through reset(seed)).  The ROM tables cover payload
+20-30 t (5-15 t with ``booms=5``) and luffing angles 45-75 deg (tabulated at 45, 60, 75 deg and
+interpolated linearly between them: first bending frequency within 0.7 % of the full model's at
+52.5 deg, tests/env/test_modal.py; ``sim_core.systems.telescopic.modal.allowed_ranges``); values
+outside raise ValueError.
 
 Episode end
 -----------
 * terminated (success): |L_s - L*| < tol_stroke (5 mm), |v| < tol_speed (5 mm/s),
-  |d| < tol_deflection (0.2 mm) and |d'| < tol_deflection_rate (2 mm/s); bonus added.
+  |d| < tol_deflection (0.2 mm; 2 mm with ``booms=5``) and |d'| < tol_deflection_rate (2 mm/s;
+  2 cm/s with ``booms=5``); bonus added.
 * truncated: t >= t_max (30 s; also max_episode_steps = 600 of the registration), or the
   solver failed / produced non-finite or out-of-bounds values: ``info["diverged"] = True``
   with ``info["reason"]`` (the observation is then the last good one: never a NaN).
 
 Rendering
 ---------
-``render_mode="rgb_array"``: side view (X-Z plane) of the three booms with the tip deflection
+``render_mode="rgb_array"``: side view (X-Z plane) of the booms with the tip deflection
 exaggerated (``render_exaggeration``, default 500x), numpy uint8 frames (H, W, 3), drawn with
 matplotlib's Agg backend.  ``"human"`` shows the same frames in a matplotlib window.
 
@@ -141,6 +170,9 @@ The registered ids keep ``-v0``; their reward and observation changed as listed 
 * reward_scale = 0.01 (all terms scaled, ratios unchanged; returns are 1/100 of the earlier
   ones: ``reward_scale=1`` gives those back), ``info["reward_unscaled"]``; the
   ``observe_parameters`` option (default off: the observation is unchanged).
+* The ``booms`` option (3 default: unchanged; 5: the five-section crane, its own payload range
+  and default payload, deflection scales and success tolerances 10 times the three-boom ones,
+  ``info["booms"]``); ``d_ref``, ``dv_ref`` as constructor arguments.
 """
 
 from __future__ import annotations
@@ -152,10 +184,18 @@ import numpy as np
 from gymnasium import spaces
 
 from sim_core.errors import SimulationError
-from sim_core.systems.telescopic.modal import ModalROM, allowed_ranges, tables_for
+from sim_core.systems.telescopic.modal import TABLE_BOOMS, ModalROM, allowed_ranges, tables_for
 from sim_core.validation.closed_form import luffing_geometry
 
 BOOM_LENGTH = 10.0          # m, SCENARIOS A1
+BOOMS = tuple(TABLE_BOOMS)  # boom counts with modal tables: 3 (the paper's), 5
+DEFAULT_PAYLOAD = {3: 25000.0, 5: 10000.0}   # kg: the paper scene's; the 5-section scenes'
+# deflection scales of the reward and the success test for three booms (m, m/s); five booms
+# take 10 times them: the paper's cubic schedule deflects the five-section tip 30.4 mm at
+# 10 t against 3.4 mm for three booms at 25 t (ratio 9)
+DEFLECTION_REFS = {"d_ref": 1e-3, "dv_ref": 1e-2, "tol_deflection": 2e-4,
+                   "tol_deflection_rate": 2e-3}
+DEFLECTION_SCALE = {3: 1.0, 5: 10.0}
 
 
 class TelescopicBoomEnv(gym.Env):
@@ -166,7 +206,7 @@ class TelescopicBoomEnv(gym.Env):
     def __init__(self, task: str = "extraction", fidelity: str = "rl", render_mode=None,
                  dt: float = 0.05, a_max: float = 0.25, v_max: float = 0.5,
                  stroke_limits: tuple[float, float] | None = None, t_max: float = 30.0,
-                 payload: float = 25000.0, luffing_angle_deg: float = 60.0,
+                 booms: int = 3, payload: float | None = None, luffing_angle_deg: float = 60.0,
                  payload_range: tuple[float, float] | None = None,
                  angle_range: tuple[float, float] | None = None,
                  n_modes: int = 3, paper_n_nodes: int = 3, paper_friction: bool = False,
@@ -175,12 +215,17 @@ class TelescopicBoomEnv(gym.Env):
                  w_end_stop: float = 10.0, bonus: float = 50.0, reward_scale: float = 0.01,
                  observe_parameters: bool = False,
                  tol_stroke: float = 5e-3, tol_speed: float = 5e-3,
-                 tol_deflection: float = 2e-4, tol_deflection_rate: float = 2e-3,
+                 tol_deflection: float | None = None, tol_deflection_rate: float | None = None,
+                 d_ref: float | None = None, dv_ref: float | None = None,
                  render_exaggeration: float = 500.0):
         if task not in ("extraction", "retraction"):
             raise ValueError(f"task = {task!r}: allowed 'extraction', 'retraction'")
         if fidelity not in ("rl", "paper"):
             raise ValueError(f"fidelity = {fidelity!r}: allowed 'rl', 'paper'")
+        if isinstance(booms, bool) or booms not in BOOMS:
+            raise ValueError(f"booms = {booms!r}: allowed {', '.join(map(str, BOOMS))} (the boom "
+                             "counts with shipped modal tables, synchronized drive)")
+        self.booms = int(booms)
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode = {render_mode!r}: allowed {self.metadata['render_modes']}")
         for name, v in (("dt", dt), ("a_max", a_max), ("v_max", v_max), ("t_max", t_max),
@@ -189,13 +234,15 @@ class TelescopicBoomEnv(gym.Env):
                 raise ValueError(f"{name} = {v!r}: must be finite and > 0")
         self.task, self.fidelity, self.render_mode = task, fidelity, render_mode
         self.dt, self.a_max, self.v_max, self.t_max = float(dt), float(a_max), float(v_max), float(t_max)
-        (p_lo, p_hi), (ang_lo, ang_hi), (L_lo, L_hi) = allowed_ranges()
+        (p_lo, p_hi), (ang_lo, ang_hi), (L_lo, L_hi) = allowed_ranges(n_booms=self.booms)
         self._ranges = {"payload": (p_lo, p_hi), "luffing_angle_deg": (ang_lo, ang_hi)}
         self.L_min, self.L_max = stroke_limits if stroke_limits is not None else (L_lo, L_hi)
         if not L_lo - 1e-9 <= self.L_min < self.L_max <= L_hi + 1e-9:
             raise ValueError(f"stroke_limits = {stroke_limits!r}: must lie within the modal "
                              f"tables' range [{L_lo:g}, {L_hi:g}] m")
         self.L_start0, self.L_target0 = (2.0, 8.0) if task == "extraction" else (8.0, 2.0)
+        if payload is None:
+            payload = DEFAULT_PAYLOAD[self.booms]
         self.payload0, self.angle0 = float(payload), float(luffing_angle_deg)
         self.payload_range, self.angle_range = payload_range, angle_range
         for nm, rng in (("payload", payload_range), ("luffing_angle_deg", angle_range)):
@@ -207,13 +254,23 @@ class TelescopicBoomEnv(gym.Env):
         self.n_modes, self.paper_n_nodes, self.paper_friction = n_modes, paper_n_nodes, paper_friction
         self.w = dict(time=w_time, progress=w_progress, deflection=w_deflection, rate=w_rate,
                       effort=w_effort, jerk=w_jerk, end_stop=w_end_stop, bonus=bonus)
-        self.tol = dict(stroke=tol_stroke, speed=tol_speed, deflection=tol_deflection,
-                        rate=tol_deflection_rate)
+        scale = DEFLECTION_SCALE[self.booms]
+        opt = dict(tol_deflection=tol_deflection, tol_deflection_rate=tol_deflection_rate,
+                   d_ref=d_ref, dv_ref=dv_ref)
+        for name, v in opt.items():
+            if v is None:
+                opt[name] = scale * DEFLECTION_REFS[name]
+            elif name.startswith("tol_") and not (math.isfinite(v) and v >= 0):
+                raise ValueError(f"{name} = {v!r}: must be finite and >= 0 (0: never met)")
+            elif not name.startswith("tol_") and not (math.isfinite(v) and v > 0):
+                raise ValueError(f"{name} = {v!r}: must be finite and > 0")
+        self.tol = dict(stroke=tol_stroke, speed=tol_speed, deflection=opt["tol_deflection"],
+                        rate=opt["tol_deflection_rate"])
         self.reward_scale = float(reward_scale)
         if observe_parameters not in (True, False):
             raise ValueError(f"observe_parameters = {observe_parameters!r}: allowed True, False")
         self.observe_parameters = bool(observe_parameters)
-        self.d_ref, self.dv_ref = 1e-3, 1e-2
+        self.d_ref, self.dv_ref = opt["d_ref"], opt["dv_ref"]
         self.exaggeration = render_exaggeration
         self.action_space = spaces.Box(-1.0, 1.0, (1,), np.float32)
         low = np.array([self.L_min, -v_max, -a_max, self.L_min, 0.0, -1.0, -1.0, -10.0, -10.0],
@@ -232,6 +289,7 @@ class TelescopicBoomEnv(gym.Env):
         lo, hi = self._ranges[name]
         if not (math.isfinite(value) and lo - 1e-9 <= value <= hi + 1e-9):
             raise ValueError(f"{name} = {value!r} outside the modal tables' range [{lo:g}, {hi:g}] "
+                             f"of booms = {self.booms} "
                              "(sim_core.systems.telescopic.modal.allowed_ranges)")
 
     def _normalised(self, name, value):
@@ -303,7 +361,7 @@ class TelescopicBoomEnv(gym.Env):
             if not (math.isfinite(x) and self.L_min <= x <= self.L_max):
                 raise ValueError(f"{nm} = {x!r}: allowed [{self.L_min:g}, {self.L_max:g}] m")
         self.payload, self.angle = payload, angle
-        self.tables = tables_for(payload, angle, self.n_modes)
+        self.tables = tables_for(payload, angle, self.n_modes, n_booms=self.booms)
         self.L_target, self.travel = Lt, max(abs(Lt - L0), 1e-3)
         self.t, self.a_prev, self._a_applied = 0.0, 0.0, 0.0
         self.rom = ModalROM(self.tables, L0, 0.0)
@@ -391,7 +449,7 @@ class TelescopicBoomEnv(gym.Env):
         return {"time": self.t, "stroke": self.rom.L, "stroke_rate": self.rom.v,
                 "velocity_saturated": bool(sat), "end_stop": bool(stop),
                 "tip_deflection": self._defl[:2].copy(), "payload": self.payload,
-                "luffing_angle_deg": self.angle, "fidelity": self.fidelity,
+                "luffing_angle_deg": self.angle, "fidelity": self.fidelity, "booms": self.booms,
                 "diverged": False, "reason": ""}
 
     def _update_deflection(self):
@@ -411,14 +469,17 @@ class TelescopicBoomEnv(gym.Env):
 
         from sim_core.systems.telescopic.params import TelescopicParams
         from sim_core.systems.telescopic.build import build_telescopic, initial_equilibrium
-        p = replace(TelescopicParams(), payload=self.payload, luffing_angle_deg=self.angle,
-                    stroke0=L0, n_nodes=self.paper_n_nodes, friction=self.paper_friction)
+        p = replace(TelescopicParams(n_booms=self.booms, mechanism="synchronized"),
+                    payload=self.payload, luffing_angle_deg=self.angle, stroke0=L0,
+                    n_nodes=self.paper_n_nodes, friction=self.paper_friction)
         self._ts = build_telescopic(p)
         z, _ = initial_equilibrium(self._ts)
         self._y = np.concatenate([z, np.zeros_like(z)])
-        self._cyl = next(c for c in self._ts.model.nonlinear if c.name == "telescopic_cylinder")
+        # synchronized drive: every cylinder (stages 1-2, 3-4, ...) follows the env's stroke
+        self._cyls = [c for c in self._ts.model.nonlinear if c.name in self._ts.drives]
         self._kin = (L0, 0.0, [])
-        self._cyl.target = self._target
+        for c in self._cyls:
+            c.target = self._target
         # deflection reference: the model's own equilibrium tip at the start, moved with the
         # tables' static tip (the tables interpolate across the retraction rope's slack/taut
         # switch near L_s = 2 m: ~1 mm off there, more than the dynamic response)
@@ -479,19 +540,23 @@ class TelescopicBoomEnv(gym.Env):
         O, e = np.asarray(geo.origin)[[0, 2]], np.asarray(geo.e_s)[[0, 2]]
         L = self.rom.L
         d = self.exaggeration * self._defl[:2]
-        total = 2 * L + BOOM_LENGTH
-        for k, (col, lw) in enumerate((("tab:blue", 7), ("tab:orange", 5), ("tab:green", 3))):
+        n = self.booms
+        total = (n - 1) * L + BOOM_LENGTH                  # boom k's left end at k L_s (synchronized)
+        colours = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple")
+        for k in range(n):
             s = np.linspace(k * L, k * L + BOOM_LENGTH, 20)
             x = s / total
             shape = 0.5 * x * x * (3 - x)          # cantilever-like interpolation of the tip deflection
             pts = O[None] + s[:, None] * e[None] + shape[:, None] * d[None]
-            ax.plot(pts[:, 0], pts[:, 1], color=col, lw=lw, solid_capstyle="butt")
+            ax.plot(pts[:, 0], pts[:, 1], color=colours[k % len(colours)], lw=7 - 4 * k / (n - 1),
+                    solid_capstyle="butt")
         tip = O + total * e + d
         ax.plot(*tip, "ks", ms=8)
-        tgt = O + (2 * self.L_target + BOOM_LENGTH) * e
+        tgt = O + ((n - 1) * self.L_target + BOOM_LENGTH) * e
         ax.plot(*tgt, "r+", ms=12)
-        ax.set_xlim(-2, 16)
-        ax.set_ylim(-1, 26)
+        reach = (n - 1) * self.L_max + BOOM_LENGTH + 2.0   # the longest boom fits
+        ax.set_xlim(-2, max(16.0, O[0] + reach * e[0]))
+        ax.set_ylim(-1, max(26.0, O[1] + reach * e[1]))
         ax.set_aspect("equal")
         ax.set_title(f"t = {self.t:5.2f} s  L_s = {L:5.3f} m  |d| = {1e3 * math.hypot(*self._defl[:2]):.2f} mm"
                      f" (x{self.exaggeration:g})", fontsize=8)

@@ -66,6 +66,93 @@ class TelescopicSystem:
     # (0, 1 bending, 2 twist) and, for the seat model, its point_effects.SliderSeat
     angle_rows: dict = field(default_factory=dict)
     seats: dict = field(default_factory=dict)
+    drives: list = field(default_factory=list)  # names of the prescribed-distance rows
+    ropes: list = field(default_factory=list)   # (extraction, retraction) RopeDrive per unit
+    stages: list = field(default_factory=list)  # schedule of each stage k (boom k -> k+1)
+
+
+def drive_layout(n_booms: int, mechanism: str) -> tuple[list[int], list[int]]:
+    """(stages with a prescribed length, booms moved by a rope unit), 0-based.
+
+    ``synchronized``: the paper's unit (Section 2: a cylinder pushes boom k+1 out of boom k, a
+    rope pair over a pulley on boom k+1 moves boom k+2 by the same stroke) repeated along the
+    boom: cylinders on stages 0, 2, 4, ..., rope units on booms 2, 4, ...  ``sequential``: one
+    cylinder moves one stage at a time while locking pins hold the others; every stage is a
+    prescribed length (the active one on its schedule, the locked ones constant) and there are
+    no ropes."""
+    if mechanism == "sequential":
+        return list(range(n_booms - 1)), []
+    return list(range(0, n_booms - 1, 2)), list(range(2, n_booms, 2))
+
+
+def drive_name(stage: int, mechanism: str) -> str:
+    """Constraint name of the prescribed length of stage ``stage`` (boom stage+1 -> stage+2)."""
+    pair = f"{stage + 1}{stage + 2}"
+    if mechanism == "sequential":
+        return f"stage_{pair}"
+    return "telescopic_cylinder" if stage == 0 else f"telescopic_cylinder_{pair}"
+
+
+def rope_names(j: int) -> tuple[str, str, str]:
+    """(extraction, retraction, inextensible) rope names of the unit moving boom j (0-based):
+    the paper's names for boom 3, suffixed by the boom number beyond."""
+    if j == 2:
+        return "extraction_rope", "retraction_rope", "rope"
+    return f"extraction_rope_{j + 1}", f"retraction_rope_{j + 1}", f"rope_{j + 1}"
+
+
+def rope_static_tension(p: TelescopicParams, j: int) -> float:
+    """Static tension (N) of boom j's extraction rope (0-based j) on the rigid, frictionless
+    boom of the synchronized drive: T_j = (m_j + ... + m_(N-1) + m_p) g sin(theta).
+
+    Axial balance of boom i with weights W_i = m_i g sin(theta) (W_p added to the tip boom):
+    rope j pulls its boom out with T_j, its pulley pulls boom j-1 in with 2 T_j, its anchor pulls
+    boom j-2 out with T_j; a cylinder on stage (i, i+1) pushes boom i+1 out and boom i in with
+    F.  Boom i+1 of a cylinder stage: F = W_(i+1) + 2 T_(i+2); boom i = j of a rope unit:
+    T_j = W_j + F - T_(j+2) = W_j + W_(j+1) + T_(j+2), which sums from the tip to the formula
+    (docs/model.md, "N-boom drives")."""
+    masses = [p.boom_length * p.sections[min(i, len(p.sections) - 1)][2]
+              for i in range(p.n_booms)]
+    return (sum(masses[j:]) + p.payload) * p.gravity * math.sin(math.radians(p.luffing_angle_deg))
+
+
+def stage_schedules(p: TelescopicParams) -> list[CubicSmoothstepSchedule]:
+    """The length L_s,k(t) of every stage k (distance of the left sections of booms k and k+1,
+    0-based), m.  ``synchronized``: every stage on the drive's cubic schedule (A4).
+    ``sequential``: one stage at a time on that schedule, shifted by the duration t_ramp +
+    t_hold_end of one stroke; extraction moves the innermost stage first (the tip section out
+    of its neighbour, then inwards), retraction the reverse order; a stage outside its window
+    holds its length (a locked pin)."""
+    n = p.n_booms - 1
+    if p.mechanism != "sequential":
+        one = CubicSmoothstepSchedule(v_max=p.v_max, t_ramp=p.t_ramp, t_hold_end=p.t_hold_end,
+                                      sign=p.direction, s0=p.stroke0)
+        return [one] * n
+    order = list(range(n - 1, -1, -1)) if p.direction > 0 else list(range(n))
+    T = p.t_ramp + p.t_hold_end
+    out = [None] * n
+    for pos, k in enumerate(order):
+        out[k] = CubicSmoothstepSchedule(v_max=p.v_max, t_ramp=p.t_ramp, t_hold_end=p.t_hold_end,
+                                         sign=p.direction, s0=p.stroke0, t_start=pos * T)
+    return out
+
+
+def active_stage(ts: TelescopicSystem, t: float) -> int:
+    """The stage (0-based) the single cylinder of the sequential drive moves at time t: the one
+    whose window [t_start, t_end) holds t; before the first window the first stage of the
+    order, after the last the last one."""
+    order = sorted(range(len(ts.stages)), key=lambda k: ts.stages[k].t_start)
+    for k in order:
+        if t < ts.stages[k].t_end:
+            return k
+    return order[-1]
+
+
+def _length_of(schedule):
+    def length(t):                                 # one sample of the schedule: (L, L', L'')
+        smp = schedule.sample(t)
+        return smp.s, smp.v, smp.a
+    return length
 
 
 def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
@@ -154,15 +241,18 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
     for k in range(N - 1):
         contact_region(f"I_{k + 1}{k + 2}", mp(k + 1, s_fixed=0.0), mp(k, s_index=s2_index[k]))
         contact_region(f"II_{k + 1}{k + 2}", mp(k, s_fixed=L), mp(k + 1, s_index=s3_index[k + 1]))
-    # telescopic cylinder between the left sections of booms 1 and 2 (A3, A4)
+    # the drive: telescopic cylinders (prescribed distances of left sections, A3, A4) and rope
+    # units (module docstring, "N-boom drives")
     sched = CubicSmoothstepSchedule(v_max=p.v_max, t_ramp=p.t_ramp, t_hold_end=p.t_hold_end,
                                     sign=p.direction, s0=Ls)
-    def cylinder_length(t):                        # one sample of the schedule: (L, L', L'')
-        smp = sched.sample(t)
-        return smp.s, smp.v, smp.a
-
-    add(distance_driver("telescopic_cylinder", mp(1, s_fixed=0.0), mp(0, s_fixed=0.0),
-                        cylinder_length))
+    stages = stage_schedules(p)
+    cylinders, rope_booms = drive_layout(N, p.mechanism)
+    drives = []
+    for k in cylinders:
+        name = drive_name(k, p.mechanism)
+        add(distance_driver(name, mp(k + 1, s_fixed=0.0), mp(k, s_fixed=0.0),
+                            _length_of(stages[k])))
+        drives.append(name)
     model.nonlinear = cons
     rows, i = {}, 0
     for nm, m in names:
@@ -173,34 +263,40 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
     pe = []
     if p.payload > 0:
         pe.append(PointMass(tip, p.payload, g_vec if p.gravity > 0 else None))
-    if N >= 3:
-        ext = [mp(0, s_fixed=0.0, offset=(0.05, 0, 0)), mp(1, s_fixed=9.0),
-               mp(2, s_fixed=0.0, offset=(-0.04, 0, 0))]
-        ret = [mp(0, s_fixed=L, offset=(0.68, 0, 0)), mp(1, s_fixed=0.66),
-               mp(2, s_fixed=0.0, offset=(0.64, 0, 0))]
+    ropes = []
+    for j in rope_booms:
+        # rope unit of boom j (0-based): anchored on boom j-2, over a pulley on boom j-1, fixed
+        # to boom j's left section (SCENARIOS A3 for j = 2, repeated along the boom)
+        ext = [mp(j - 2, s_fixed=0.0, offset=(0.05, 0, 0)), mp(j - 1, s_fixed=9.0),
+               mp(j, s_fixed=0.0, offset=(-0.04, 0, 0))]
+        ret = [mp(j - 2, s_fixed=L, offset=(0.68, 0, 0)), mp(j - 1, s_fixed=0.66),
+               mp(j, s_fixed=0.0, offset=(0.64, 0, 0))]
+        en, rn, bn = rope_names(j)
         if p.rope_elasticity:
             EA = p.rope_EA * p.E / 2.1e11
-            rope = RopeDrive(ext, EA, 1.0, name="extraction_rope")
+            rope = RopeDrive(ext, EA, 1.0, name=en)
             ell_e = float(rope.length(Q0)[0])
             # unstretched length from the static rope tension of the rigid, frictionless boom:
-            # T = (m3 + m_p) g sin(theta) (SCENARIOS C7; m3 = boom 3's mass, Table 2)
-            m3 = p.boom_length * p.sections[min(2, len(p.sections) - 1)][2]
-            T0 = (m3 + p.payload) * p.gravity * math.sin(theta)
+            # the rope of boom j carries booms j..N and the payload, T = (sum m_i + m_p) g
+            # sin(theta) (SCENARIOS C7 for j = 2: (m3 + m_p) g sin(theta))
+            T0 = rope_static_tension(p, j)
             rope.L0 = ell_e / (1.0 + T0 / EA)
-            retr = RopeDrive(ret, EA, 1.0, name="retraction_rope")
+            retr = RopeDrive(ret, EA, 1.0, name=rn)
             retr.L0 = float(retr.length(Q0)[0])         # just taut
             pe += [rope, retr]
+            ropes.append((rope, retr))
         else:
             # effects.rope_elasticity = false: one inextensible bilateral rope (its multiplier's
             # sign tells which of the two ropes is taut); nothing of the rope springs is computed
-            ell_e = float(np.real(rope_length("rope", ext, 0.0).evaluate(Q0)[0][0]))
-            c = rope_length("rope", ext, ell_e)
-            cons.append(c)
-            rows["rope"] = slice(i, i + 1)
+            ell_e = float(np.real(rope_length(bn, ext, 0.0).evaluate(Q0)[0][0]))
+            cons.append(rope_length(bn, ext, ell_e))
+            rows[bn] = slice(i, i + 1)
+            i += 1
             model.nonlinear = cons
     model.point_effects = pe + list(seats.values())
     ts = TelescopicSystem(model, Q0, sched, s2_index, s3_index, rows, tip, p,
-                          angle_rows=angle_rows, seats=seats)
+                          angle_rows=angle_rows, seats=seats, drives=drives, ropes=ropes,
+                          stages=stages)
     # Section 8 contact analysis: the slider-spring distribution needs the paper's three-boom
     # slider geometry; with friction off it is only evaluated for the outputs (it does not act
     # on the motion), with contact_distribution off it is not built at all
@@ -283,12 +379,10 @@ def _initial_equilibrium(ts: TelescopicSystem, t: float):
     from sim_core.model.statics import constrained_static_equilibrium
     m = ts.model
     z0, _ = m.reduced_state(t, ts.Q0, np.zeros_like(ts.Q0))
-    ropes = {pe.name: pe for pe in m.point_effects if isinstance(pe, RopeDrive)}
-    ext, retr = ropes.get("extraction_rope"), ropes.get("retraction_rope")
-    if retr is not None:
-        retr.L0 = np.inf
-    if ext is None or retr is None:
+    if not ts.ropes:
         return constrained_static_equilibrium(m, z0, t)
+    for _, retr in ts.ropes:
+        retr.L0 = np.inf
 
     def length(rope, z):
         Q, _ = m.full_state(t, z, np.zeros_like(z))
@@ -299,30 +393,42 @@ def _initial_equilibrium(ts: TelescopicSystem, t: float):
         (EA/L0)(ell - L0 - s/2) = T."""
         return rope.EA * (ell - 0.5 * rope.slack_width) / (rope.EA + T)
 
-    k_e = ext.EA / ext.L0
-    if ext.tension(length(ext, z0)) > k_e * ext.slack_width:       # stiff branch: as A3 says
+    def stiff(ext, z):
+        return ext.tension(length(ext, z)) > ext.EA / ext.L0 * ext.slack_width
+
+    soft = [(ext, retr) for ext, retr in ts.ropes if not stiff(ext, z0)]
+    soft_ids = {id(ext) for ext, _ in soft}
+    if not soft:                                   # every rope in its stiff branch: as A3 says
         z, lam = constrained_static_equilibrium(m, z0, t)
-        retr.L0 = length(retr, z)
+        for _, retr in ts.ropes:
+            retr.L0 = length(retr, z)
         return z, lam
-    ext.bilateral = True
+    for ext, _ in soft:
+        ext.bilateral = True
     try:
         z, lam = constrained_static_equilibrium(m, z0, t)
-        ell_e = length(ext, z)
-        T = ext.tension(ell_e)
+        tensions = [ext.tension(length(ext, z)) for ext, _ in soft]
     finally:
-        ext.bilateral = False
-    s = ext.slack_width
-    ell_r = length(retr, z)
-    if T >= k_e * s:
-        # the extraction rope carries T in its stiff branch: same forces, nothing to re-solve
-        ext.L0 = taut_L0(ext, ell_e, T)
-        retr.L0 = ell_r
-        return z, lam
-    # near zero or compressive: both ropes taut (the net pull T shared as T_min + max(+-T, 0))
-    T_min = 0.5 * k_e * s
-    ext.L0 = taut_L0(ext, ell_e, T_min + max(T, 0.0))
-    retr.L0 = taut_L0(retr, ell_r, T_min + max(-T, 0.0))
-    return constrained_static_equilibrium(m, z, t)
+        for ext, _ in soft:
+            ext.bilateral = False
+    resolve = False
+    for ext, retr in ts.ropes:
+        if id(ext) not in soft_ids:
+            retr.L0 = length(retr, z)
+    for (ext, retr), T in zip(soft, tensions):
+        k_e, s = ext.EA / ext.L0, ext.slack_width
+        ell_e, ell_r = length(ext, z), length(retr, z)
+        if T >= k_e * s:
+            # the extraction rope carries T in its stiff branch: same forces, nothing to re-solve
+            ext.L0 = taut_L0(ext, ell_e, T)
+            retr.L0 = ell_r
+            continue
+        # near zero or compressive: both ropes taut (the net pull T shared as T_min + max(+-T, 0))
+        T_min = 0.5 * k_e * s
+        ext.L0 = taut_L0(ext, ell_e, T_min + max(T, 0.0))
+        retr.L0 = taut_L0(retr, ell_r, T_min + max(-T, 0.0))
+        resolve = True
+    return constrained_static_equilibrium(m, z, t) if resolve else (z, lam)
 
 
 def simulate_telescopic(p: TelescopicParams, t_end: float = 20.0, n_output: int = 201,
@@ -361,11 +467,10 @@ def _telescopic_result(ts: TelescopicSystem, t, ys, stats, error, scene=None):
     out = {k: [] for k in ("tip_position", "tip_velocity", "tip_acceleration", "piston_stroke",
                            "luffing_cylinder_force", "telescopic_cylinder_force",
                            "contact_point_forces", "inner_contact_s", "outer_contact_s",
-                           "constraint_violation")}
+                           "constraint_violation", "stage_stroke", "drive_forces")}
     from sim_core.physics.contact.friction import region_multipliers, section_reaction
     basis = m.beams[0].reference_basis
-    left1 = material_point(m, 0, s_fixed=0.0)
-    left2 = material_point(m, 1, s_fixed=0.0)
+    lefts = [material_point(m, k, s_fixed=0.0) for k in range(N)]
     for tk, y in zip(t, ys):
         z, zd = y[:n], y[n:]
         zdd, lam = m.accelerations_and_multipliers(tk, z, zd)
@@ -376,9 +481,15 @@ def _telescopic_result(ts: TelescopicSystem, t, ys, stats, error, scene=None):
         out["tip_position"].append(r)
         out["tip_velocity"].append(J @ Qd)
         out["tip_acceleration"].append(J @ Qdd + (Jc @ Qd).imag / 1e-20)
-        out["piston_stroke"].append(np.linalg.norm(left2(Q)[0] - left1(Q)[0]) - p.stroke0)
+        a = [lp(Q)[0] for lp in lefts]
+        stroke = [np.linalg.norm(a[k + 1] - a[k]) - p.stroke0 for k in range(N - 1)]
+        forces = [lam[ts.rows[name]][0] for name in ts.drives]
+        cyl = active_stage(ts, tk) if p.mechanism == "sequential" else 0
+        out["stage_stroke"].append(stroke)
+        out["drive_forces"].append(forces)
+        out["piston_stroke"].append(stroke[cyl])
         out["luffing_cylinder_force"].append(lam[ts.rows["luffing_cylinder"]][0])
-        out["telescopic_cylinder_force"].append(lam[ts.rows["telescopic_cylinder"]][0])
+        out["telescopic_cylinder_force"].append(forces[cyl])
         cpf = []
         for k in range(N - 1):
             inner = material_point(m, k, s_index=ts.s2_index[k])
@@ -399,6 +510,9 @@ def _telescopic_result(ts: TelescopicSystem, t, ys, stats, error, scene=None):
                 out.setdefault("friction_coefficient", []).append([mu for _, _, mu, _ in sols])
         if "rope" in ts.rows:
             out.setdefault("rope_tension", []).append(-lam[ts.rows["rope"]][0])
+        if ts.ropes:
+            out.setdefault("rope_tensions", []).append(
+                [r.tension(float(np.real(r.length(Q)[0]))) for unit in ts.ropes for r in unit])
         out["inner_contact_s"].append(Q[ts.s2_index])
         out["outer_contact_s"].append(Q[ts.s3_index[1:]])
         out["constraint_violation"].append(np.max(np.abs(m.constraint_violation(tk, z, zd))))

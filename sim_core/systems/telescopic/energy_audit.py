@@ -100,8 +100,8 @@ class AuditedSystem:
         m = ts.model
         self.n = m.n_dof
         self.filter = next((e for e in m.effects if e.name == "filtering"), None)
-        self.cyl = next(c for c in m.nonlinear if c.name == "telescopic_cylinder")
-        self.cyl_row = ts.rows["telescopic_cylinder"]
+        # every prescribed stage length (cylinders, and the locked stages of the sequential drive)
+        self.drives = [(c, ts.rows[c.name]) for c in m.nonlinear if c.name in ts.drives]
 
     def powers(self, t: float, z: np.ndarray, zd: np.ndarray):
         """(z_ddot, powers in W of self.terms, in that order)."""
@@ -113,8 +113,8 @@ class AuditedSystem:
             _, J, _, _ = constraint_terms(m.nonlinear, t, Q, Qd)
             P["constraint_work"] = float(lam @ (J @ Qd))
         if "drive_work" in self.terms:
-            b_dot = np.atleast_1d(self.cyl.target(t)[1]) if self.cyl.target is not None else 0.0
-            P["drive_work"] = float(np.sum(lam[self.cyl_row] * b_dot))
+            P["drive_work"] = float(sum(np.sum(lam[row] * np.atleast_1d(c.target(t)[1]))
+                                        for c, row in self.drives))
         if "friction_work" in self.terms:
             P["friction_work"] = (float(Qd @ sum(mf.forces(t, Q, Qd, lam)
                                                  for mf in m.multiplier_forces))

@@ -1,19 +1,31 @@
 """Stroke-parametric modal reduced-order model (ROM) of the telescopic boom system, derived from
 the full sim_core model (sim_core.systems.telescopic.build, Zhao-Qi-Wang 2024).  SI units throughout.
 
-Table build (``python -m sim_core.systems.telescopic.modal --build``, a few minutes per configuration)
------------------------------------------------------------------------------------------------
+Table build (``python -m sim_core.systems.telescopic.modal --build [--booms 5]``)
+-------------------------------------------------------------------------------
+Tables exist for the paper's three booms (``data/modal_telescopic.npz``) and for five sections
+(``data/modal_telescopic_5.npz``: the paper's three inside two larger ones,
+``params.crane_sections``), both with the synchronized drive: every stage moves with the same
+piston length L_s, so one stroke coordinate parametrises the equilibrium (``data_path``,
+``TABLE_BOOMS``).  Each file records its boom count (``n_booms``; a file without it holds three)
+and its grid, which sets the ranges the ROM accepts (``allowed_ranges``).  One grid point costs
+about 2 s at 223 coordinates (five booms, n_nodes = 3; 99 points in 5 minutes on 2 shared
+cores; build logs beside the data).
+
 For every configuration (payload mass m_p kg, luffing angle theta deg) and every piston length
 L_s (m) of a grid spanning the telescopic stroke range, with the *full* sim_core model at a coarse
 discretisation (n_nodes = 3 per spline element, frictionless resultants, stress filter on):
 
-1. the telescopic cylinder is frozen at L_s (``build_telescopic`` with stroke0 = L_s: the
+1. every telescopic cylinder is frozen at L_s (``build_telescopic`` with stroke0 = L_s: the
    cylinder target is L_s with zero rate and acceleration at t = 0) and the static equilibrium
    z_s(L_s) under gravity and payload is solved (``constrained_static_equilibrium``).  The ropes
-   keep the unstretched lengths of the reference build at ``stroke_ref`` (the physical ropes of
-   the scene; their lengths are stroke invariant, SCENARIOS A3);
-2. the reduced tangent stiffness K = -d(F_r + C^T lambda)/dz (central differences, constraint
-   multipliers frozen: geometric stiffness of the constraints included), the reduced damping
+   (every rope unit of the crane) keep the unstretched lengths of the reference build at
+   ``stroke_ref`` (the physical ropes of the scene; their lengths are stroke invariant,
+   SCENARIOS A3);
+2. the reduced tangent stiffness K = -d(F_r + C^T lambda)/dz (``tangent_stiffness``: central
+   differences, step 1e-8 max(1, max|z|), symmetrised; the three-boom file was built with
+   forward differences, step 1e-7; constraint multipliers frozen: geometric stiffness of the
+   constraints included), the reduced damping
    D = -dF_r/dz_dot (stress-filter damping, second seed Eq. 53) and the reduced mass M_r (with
    the filter's (h^2/6) K mass term) are evaluated about z_s;
 3. constrained modes: K N x = omega^2 M_r N x on the null space N of the constraint Jacobian
@@ -22,8 +34,9 @@ discretisation (n_nodes = 3 per spline element, frictionless resultants, stress 
    the in-plane stroke motion.  The lowest ``N_MODES_TABLE`` in-plane modes are kept, signs
    aligned from grid point to grid point (phi_prev^T M_r phi > 0);
 4. the stroke tangent dz_s/dL_s follows exactly from the implicit-function theorem on the
-   equilibrium (KKT system [-K C^T; C 0] [dz; dlambda] = [0; e_cyl]), checked against the
-   difference quotient of the neighbouring equilibria (reported by --build);
+   equilibrium (KKT system [-K C^T; C 0] [dz; dlambda] = [0; e_cyl], e_cyl = 1 in the row of
+   every cylinder), checked against the difference quotient of the neighbouring equilibria
+   (reported by --build);
 5. modal loads: Gamma_i = phi_i^T M_r dz_s/dL_s (participation of the stroke acceleration),
    and the velocity-dependent loads of the steady sliding motion Qdot = Q_s' v,
    b1_i v + b2_i v^2 = phi_i^T [F(Q_s, Q_s' v) - F(Q_s, 0)] (convective/filter terms of the
@@ -61,21 +74,45 @@ from pathlib import Path
 import numpy as np
 import scipy.linalg as sla
 
+from sim_core.errors import SimulationError
 from sim_core.result import atomic_write_bytes
 from sim_core.systems.telescopic.build import build_telescopic, initial_equilibrium
 from sim_core.systems.telescopic.params import TelescopicParams
 
-DATA = Path(__file__).parent / "data" / "modal_telescopic.npz"
+DATA = Path(__file__).parent / "data" / "modal_telescopic.npz"      # the paper's three booms
 N_MODES_TABLE = 4
 # Table grid (SCENARIOS A4 stroke range 2 -> 8 m plus margin for the end stops of boom_env).
 L_GRID = np.linspace(1.75, 8.25, 11)       # avoids stroke_ref = 2 m (rope kink, see below)
 PAYLOADS = (20000.0, 25000.0, 30000.0)          # kg
 ANGLES = (45.0, 60.0, 75.0)                     # deg (the paper's 60 deg +- 15 deg)
+# shipped table sets: boom count -> default payloads (kg) of its build.  Five sections (the
+# paper's three inside two larger ones, params.crane_sections) carry 5-15 t: 10 t at 42 m keeps
+# boom 1's root bending stress near the paper scene's (scene telescopic_extraction_5)
+TABLE_BOOMS = {3: PAYLOADS, 5: (5000.0, 10000.0, 15000.0)}
 N_NODES = 3
 STROKE_REF = 2.0
 V_REF = 0.5                                     # m/s, for the velocity-dependent loads
+K_REL_STEP = 1e-8           # difference step of K per unit of max(1, max|z|) (tangent_stiffness)
+CLUSTER_GAP = 0.02          # relative gap of omega^2 below which modes form one cluster
 
 COLS = ("omega", "zeta", "gamma", "gamma2", "b1", "b2", "phi_x", "phi_z")
+
+
+def data_path(n_booms: int = 3) -> Path:
+    """File of the modal tables of an ``n_booms``-section crane (synchronized drive):
+    ``data/modal_telescopic.npz`` for the paper's three booms, ``modal_telescopic_<N>.npz``
+    otherwise.  ValueError for a count without shipped tables."""
+    if n_booms not in TABLE_BOOMS:
+        raise ValueError(f"n_booms = {n_booms!r}: modal tables exist for booms "
+                         f"{', '.join(str(k) for k in TABLE_BOOMS)} (allowed values)")
+    return DATA if n_booms == 3 else DATA.with_name(f"modal_telescopic_{n_booms}.npz")
+
+
+def table_params(n_booms: int = 3) -> TelescopicParams:
+    """The TelescopicParams the tables of ``n_booms`` sections are built from (payload, angle,
+    stroke and n_nodes set per configuration; frictionless, synchronized drive)."""
+    data_path(n_booms)
+    return TelescopicParams(n_booms=n_booms, mechanism="synchronized")
 
 
 def _frozen_system(params, L_s):
@@ -86,20 +123,36 @@ def _ropes(model):
     return {pe.name: pe for pe in model.point_effects if hasattr(pe, "L0")}
 
 
-def linearize_at(params, L_s, rope_L0: dict, z_guess=None, lam_guess=None):
-    """Equilibrium, modes and modal loads of the full model with the cylinder frozen at L_s (m).
-
-    Returns a dict (see module docstring) with z-space quantities for continuation."""
+def equilibrium_at(params, L_s, rope_L0: dict, z_guess=None):
+    """(system, z, lambda): the full model (TelescopicParams ``params``) with every cylinder
+    frozen at piston length L_s (m), the ropes at the unstretched lengths ``rope_L0`` (m, by
+    name: every rope unit of the crane), in static equilibrium at t = 0.  ``z_guess``: start
+    of the Newton iteration relative to the built configuration (continuation)."""
     from sim_core.model.statics import constrained_static_equilibrium
-    from sim_core.physics.constraints import constraint_terms
     ts = _frozen_system(params, L_s)
     m = ts.model
-    for name, r in _ropes(m).items():
+    ropes = _ropes(m)
+    if set(ropes) != set(rope_L0):
+        raise ValueError(f"rope_L0 names {sorted(rope_L0)} differ from the model's ropes "
+                         f"{sorted(ropes)}")
+    for name, r in ropes.items():
         r.L0 = rope_L0[name]
     z0, _ = m.reduced_state(0.0, ts.Q0, np.zeros_like(ts.Q0))
     if z_guess is not None:
         z0 = z0 + z_guess
     z, lam = constrained_static_equilibrium(m, z0, 0.0)
+    return ts, z, lam
+
+
+def linearize_at(params, L_s, rope_L0: dict, z_guess=None, lam_guess=None,
+                 k_rel_step=K_REL_STEP, k_central=True):
+    """Equilibrium, modes and modal loads of the full model with the cylinders frozen at L_s (m).
+    ``k_rel_step``, ``k_central``: the differences of K (``tangent_stiffness``).
+
+    Returns a dict (see module docstring) with z-space quantities for continuation."""
+    from sim_core.physics.constraints import constraint_terms
+    ts, z, lam = equilibrium_at(params, L_s, rope_L0, z_guess)
+    m = ts.model
     n = len(z)
     zero = np.zeros(n)
 
@@ -111,21 +164,14 @@ def linearize_at(params, L_s, rope_L0: dict, z_guess=None, lam_guess=None):
         return m.P.T @ F, C
 
     Fr0, C = parts(z)
-    r0 = Fr0 + C.T @ lam
-    h = 1e-7 * max(1.0, float(np.max(np.abs(z))))
-    K = np.empty((n, n))
-    for j in range(n):                                  # forward differences (n evaluations)
-        dz = np.zeros(n)
-        dz[j] = h
-        fp, Cp = parts(z + dz)
-        K[:, j] = -((fp + Cp.T @ lam) - r0) / h
-    K = 0.5 * (K + K.T)
+    K = tangent_stiffness(parts, z, lam, k_rel_step, k_central)
     Q, _ = m.full_state(0.0, z, zero)
     M, _ = m.mass_force(0.0, Q, np.zeros_like(Q))
     Mr = m.P.T @ M @ m.P
     Nb = sla.null_space(C)
     w2, X = sla.eigh(Nb.T @ K @ Nb, Nb.T @ Mr @ Nb)
     phi = Nb @ X                                       # mass-normalised: phi^T Mr phi = I
+    w2, phi = _separate_planes(w2, phi, _end_displacements(ts, Q))
     _, Jt, _, _ = ts.tip(Q)
     tip_modes = Jt @ m.P @ phi                         # (3, n_modes_all)
     inplane = np.hypot(tip_modes[0], tip_modes[2]) > 10.0 * np.abs(tip_modes[1])
@@ -133,7 +179,8 @@ def linearize_at(params, L_s, rope_L0: dict, z_guess=None, lam_guess=None):
     # stroke tangent from the implicit-function theorem (cylinder row: g = L_s)
     mC = C.shape[0]
     e = np.zeros(mC)
-    e[ts.rows["telescopic_cylinder"]] = 1.0
+    for name in ts.drives:                             # synchronized: every stage moves with L_s
+        e[ts.rows[name]] = 1.0
     # particular solution of C dz = e plus the null-space correction N y with N^T K dz = 0
     # (robust to redundant constraint rows, which make the KKT matrix singular)
     dz_p = np.linalg.lstsq(C, e, rcond=None)[0]
@@ -159,6 +206,96 @@ def linearize_at(params, L_s, rope_L0: dict, z_guess=None, lam_guess=None):
             "all_freq_hz": np.sqrt(np.clip(w2[:12], 0, None)) / (2 * np.pi)}
 
 
+def _end_displacements(ts, Q):
+    """(3, 2 N_booms, n) map of reduced coordinates to the global X, Y (lateral), Z
+    displacements of both ends of every boom, at the configuration Q."""
+    from sim_core.physics.constraints import material_point
+    m = ts.model
+    L = ts.params.boom_length
+    J = [material_point(m, k, s_fixed=s)(Q)[1] @ m.P for k in range(len(m.beams))
+         for s in (0.0, L)]
+    return np.stack(J, axis=1)
+
+
+def _separate_planes(w2, phi, D, gap=CLUSTER_GAP, tol=1e-3):
+    """Modes (omega^2 (n_m,), mass-normalised phi (n, n_m)) with near-degenerate in-plane and
+    lateral modes separated.
+
+    The luffing plane X-Z is a plane of symmetry of the scene: in-plane and lateral modes
+    decouple exactly.  Where an in-plane and a lateral frequency nearly coincide (relative gap
+    of omega^2 below ``gap``; five booms at L_s = 1.75 m, 10 t, 60 deg: 1.4171 and 1.4197 Hz)
+    the difference error of K (its asymmetric part, ``tangent_stiffness``) mixes them, and the
+    tip criterion of the caller drops both.  Within each such cluster the lateral displacements
+    of the boom ends, ``D[1] @ phi`` (D: (3, p, n) from ``_end_displacements``), split the mode
+    space: their row space (singular values above ``tol`` times the largest end displacement of
+    the cluster's modes) holds the lateral combinations, its null space the in-plane ones.  Each
+    part is re-diagonalised (Rayleigh-Ritz with K = diag(omega^2) in the cluster's M-orthonormal
+    basis), so the vectors stay M-orthonormal; the discarded coupling between the parts is
+    the noise (zero by symmetry), and the separated frequencies are Rayleigh quotients inside
+    the cluster (exact to the cluster's width, and to the noise's share of it where the mixing
+    is slight).  Clusters of one kind only are left as they are."""
+    w2 = np.array(w2, dtype=float)
+    phi = np.array(phi, dtype=float)
+    i = 0
+    nm = len(w2)
+    while i < nm:
+        j = i
+        while j + 1 < nm and w2[j + 1] - w2[j] <= gap * abs(w2[j + 1]):
+            j += 1
+        if j > i:
+            idx = np.arange(i, j + 1)
+            Yc = D[1] @ phi[:, idx]
+            scale = np.max(np.linalg.norm(D @ phi[:, idx], axis=(0, 1)))
+            _, sv, Vt = np.linalg.svd(Yc)
+            r = int(np.sum(sv > tol * scale))
+            if 0 < r < len(idx):
+                W = np.diag(w2[idx])
+                new_w, new_v = [], []
+                for S in (Vt[:r].T, Vt[r:].T):          # lateral, in-plane combinations
+                    vals, R = np.linalg.eigh(S.T @ W @ S)
+                    new_w.append(vals)
+                    new_v.append(phi[:, idx] @ S @ R)
+                w2[idx] = np.concatenate(new_w)
+                phi[:, idx] = np.hstack(new_v)
+        i = j + 1
+    order = np.argsort(w2, kind="stable")
+    return w2[order], phi[:, order]
+
+
+def tangent_stiffness(parts, z, lam, rel_step=K_REL_STEP, central=True, symmetrise=True):
+    """K = -d(F_r + C^T lambda)/dz at frozen multipliers lambda, symmetrised (SI units of
+    force per unit of each coordinate); ``parts(z) -> (F_r, C)`` gives the reduced force and
+    the constraint Jacobian.
+
+    Central differences with one step h = rel_step max(1, max|z|) for every coordinate
+    (truncation error h^2/6 times the third derivative of the potential).  The step matters:
+    a tension-only rope near zero tension has its slack kink (a C1 ramp over slack_width =
+    1e-6 m, point_effects.RopeDrive) within micrometres of the equilibrium, and forward
+    differences with h = 1e-7 max|z| (2.3e-6 at five booms) gave K an asymmetry of
+    7e-4 max|K| there: at five booms, 75 deg, 5 t, L_s = 3.05 m the third in-plane mode moved
+    from 4.40 to 5.05 Hz and the tip slope of the stroke tangent from 4.00 to 3.54 m/m (the
+    first mode by 2e-6).  The exact K is symmetric (conservative elastic, gravity, rope and
+    constraint forces), so the asymmetric part of the differenced K measures its error: 3e-9
+    max|K| with the default step there.  ``central=False``, ``rel_step=1e-7``: the forward
+    differences the three-boom tables were built with.  ``symmetrise=False``: the differenced
+    K as it is (for its error estimate)."""
+    n = len(z)
+    f0, C0 = parts(z)
+    r0 = f0 + C0.T @ lam
+    h = rel_step * max(1.0, float(np.max(np.abs(z))))
+    K = np.empty((n, n))
+    for j in range(n):
+        dz = np.zeros(n)
+        dz[j] = h
+        fp, Cp = parts(z + dz)
+        if central:
+            fm, Cm = parts(z - dz)
+            K[:, j] = -((fp + Cp.T @ lam) - (fm + Cm.T @ lam)) / (2.0 * h)
+        else:
+            K[:, j] = -((fp + Cp.T @ lam) - r0) / h
+    return 0.5 * (K + K.T) if symmetrise else K
+
+
 def reference_rope_lengths(p, stroke_ref=STROKE_REF) -> dict:
     """Unstretched rope lengths (m) of the scene ``p`` (TelescopicParams): those of its static
     equilibrium at piston length ``stroke_ref``, where the retraction rope is set just taut
@@ -180,7 +317,16 @@ def build_config(payload, angle_deg, L_grid=L_GRID, stroke_ref=STROKE_REF, n_nod
         t0 = time.perf_counter()
         near = [j for j in range(len(L_grid)) if res[j] is not None]
         guess = res[min(near, key=lambda j: abs(L_grid[j] - L_grid[i]))]["z_rel"] if near else None
-        res[i] = linearize_at(p, L_grid[i], rope_L0, z_guess=guess)
+        try:
+            res[i] = linearize_at(p, L_grid[i], rope_L0, z_guess=guess)
+        except SimulationError as exc:
+            if guess is None:
+                raise
+            # the neighbour's equilibrium is too far for Newton (five booms, 45 deg, 10 t,
+            # 7.6 -> 8.25 m): load continuation from the built configuration instead
+            log(f"  L_s={L_grid[i]:.3f} m: continuation from the neighbour failed ({exc}); "
+                "solved from the built configuration")
+            res[i] = linearize_at(p, L_grid[i], rope_L0)
         log(f"  m_p={payload:g} kg theta={angle_deg:g} deg L_s={L_grid[i]:.3f} m: in-plane f = "
             + ", ".join(f"{w / 2 / np.pi:.3f}" for w in res[i]["omega"])
             + " Hz, zeta = " + ", ".join(f"{x:.4f}" for x in res[i]["zeta"])
@@ -222,19 +368,33 @@ def build_config(payload, angle_deg, L_grid=L_GRID, stroke_ref=STROKE_REF, n_nod
     return out
 
 
-def build_tables(path=DATA, payloads=PAYLOADS, angles=ANGLES, L_grid=L_GRID, log=print,
-                 reuse=None):
-    """Build all configurations and write them to ``path`` (npz).  ``reuse``: existing tables
-    file(s) (a path or a list of paths); configurations they hold on the same L_s grid are
-    copied, not rebuilt (this also merges tables built in separate processes, one per angle)."""
+def build_tables(path=None, payloads=None, angles=ANGLES, L_grid=L_GRID, log=print,
+                 reuse=None, n_booms: int = 3, base: TelescopicParams | None = None):
+    """Build all configurations and write them to ``path`` (npz, written atomically; default
+    ``data_path(n_booms)``).  ``n_booms``: sections of the crane (synchronized drive; ``base``:
+    other TelescopicParams to start from, its n_booms wins); ``payloads`` default to
+    ``TABLE_BOOMS[n_booms]``.  ``reuse``: existing tables file(s) (a path or a list of paths);
+    configurations they hold for the same boom count on the same L_s grid are copied, not
+    rebuilt (this also merges tables built in separate processes, one per angle)."""
+    if base is None:
+        base = table_params(n_booms)
+    n_booms = base.n_booms
+    if base.mechanism != "synchronized":
+        raise ValueError(f"mechanism = {base.mechanism!r}: the modal tables follow one stroke "
+                         "coordinate (allowed: 'synchronized')")
+    path = data_path(n_booms) if path is None else path
+    payloads = TABLE_BOOMS.get(n_booms, PAYLOADS) if payloads is None else payloads
     t0 = time.perf_counter()
     data = {}
     olds = []
+    used = {}                                    # reused files: their build times, s
     for src in ([] if reuse is None else [reuse] if isinstance(reuse, (str, Path)) else reuse):
         if Path(src).exists():
             with np.load(src) as f:
                 old = {k: f[k] for k in f.files}
-            if old["L_grid"].shape == np.shape(L_grid) and np.allclose(old["L_grid"], L_grid):
+            same_booms = int(old.get("n_booms", 3)) == n_booms
+            if (same_booms and old["L_grid"].shape == np.shape(L_grid)
+                    and np.allclose(old["L_grid"], L_grid)):
                 olds.append((src, old))
     for a in angles:
         for mp_ in payloads:
@@ -246,15 +406,18 @@ def build_tables(path=DATA, payloads=PAYLOADS, angles=ANGLES, L_grid=L_GRID, log
                     cfg = {k: old[k][ia[0], ip[0]] for k in COLS + ("tip_static", "tip_dL",
                                                                      "freq_all_hz")}
                     log(f"  m_p={mp_:g} kg theta={a:g} deg: reused from {src}")
+                    used[str(src)] = float(old.get("build_s", 0.0))
                     break
             if cfg is None:
-                cfg = build_config(mp_, a, L_grid, log=log)
+                cfg = build_config(mp_, a, L_grid, base=base, log=log)
             for k, v in cfg.items():
                 data.setdefault(k, []).append(v)
     arrays = {k: np.array(v).reshape(len(angles), len(payloads), *np.shape(v[0]))
               for k, v in data.items()}
     meta = dict(L_grid=np.asarray(L_grid), payloads=np.asarray(payloads), angles=np.asarray(angles),
-                n_nodes=N_NODES, stroke_ref=STROKE_REF, build_s=time.perf_counter() - t0)
+                n_nodes=N_NODES, stroke_ref=STROKE_REF,
+                build_s=time.perf_counter() - t0 + sum(used.values()),   # reused builds included
+                n_booms=n_booms, mechanism="synchronized")
     buf = io.BytesIO()
     np.savez_compressed(buf, **arrays, **meta)
     atomic_write_bytes(path, buf.getvalue())
@@ -312,31 +475,41 @@ class ModalTables:
 _CACHE: dict = {}
 
 
-def load_raw(path=DATA) -> dict:
+def load_raw(path=None, n_booms: int = 3) -> dict:
+    """The arrays of a tables file (``path``, default ``data_path(n_booms)``), cached."""
+    path = data_path(n_booms) if path is None else path
     key = str(path)
     if key not in _CACHE:
         if not Path(path).exists():
             raise FileNotFoundError(f"{path}: modal tables missing; build them with "
-                                    "`python -m sim_core.systems.telescopic.modal --build`")
+                                    "`python -m sim_core.systems.telescopic.modal --build "
+                                    f"--booms {n_booms}`")
         with np.load(path) as f:
-            _CACHE[key] = {k: f[k] for k in f.files}
+            raw = {k: f[k] for k in f.files}
+        held = int(raw.get("n_booms", 3))           # files without the key: the paper's 3 booms
+        if held != n_booms:
+            raise ValueError(f"{path} holds tables of {held} booms, not n_booms = {n_booms}")
+        _CACHE[key] = raw
     return _CACHE[key]
 
 
-def allowed_ranges(path=DATA):
-    """(payload (lo, hi) kg, luffing angle (lo, hi) deg, L_s (lo, hi) m) covered by the tables."""
-    r = load_raw(path)
+def allowed_ranges(path=None, n_booms: int = 3):
+    """(payload (lo, hi) kg, luffing angle (lo, hi) deg, L_s (lo, hi) m) covered by the tables
+    of ``n_booms`` sections (read from the file: a partial build narrows them)."""
+    r = load_raw(path, n_booms)
     return ((float(r["payloads"][0]), float(r["payloads"][-1])),
             (float(r["angles"][0]), float(r["angles"][-1])),
             (float(r["L_grid"][0]), float(r["L_grid"][-1])))
 
 
 def tables_for(payload: float, angle_deg: float, n_modes: int = N_MODES_TABLE,
-               path=DATA) -> ModalTables:
-    """Bilinear interpolation of the configuration tables in (angle, payload).
+               path=None, n_booms: int = 3) -> ModalTables:
+    """Bilinear interpolation of the configuration tables of ``n_booms`` sections in (angle,
+    payload).
 
-    Raises ValueError outside the tabulated ranges (no extrapolation)."""
-    r = load_raw(path)
+    Raises ValueError outside the tabulated ranges (no extrapolation) and for a boom count
+    without tables."""
+    r = load_raw(path, n_booms)
     P, A = r["payloads"], r["angles"]
     if not (P[0] - 1e-9 <= payload <= P[-1] + 1e-9):
         raise ValueError(f"payload = {payload!r} kg outside the modal tables' range "
@@ -364,9 +537,10 @@ def tables_for(payload: float, angle_deg: float, n_modes: int = N_MODES_TABLE,
 
     coef = np.stack([get(k)[:, :n_modes] for k in COLS], axis=1)
     # the scene is symmetric about the luffing plane: the static tip has no lateral (Y) part and
-    # neither has its stroke derivative.  The tabulated Y derivative (up to 0.25 m/m at 8.25 m)
-    # is the round-off of the implicit-function solve through the nearly singular lateral /
-    # torsion directions of the forward-difference tangent of the build, not physics: drop it.
+    # neither has its stroke derivative.  The Y derivative of the three-boom file (up to 0.25 m/m
+    # at 8.25 m) is the error of its forward-difference K (tangent_stiffness) amplified by the
+    # implicit-function solve through the soft lateral / torsion directions, not physics: drop
+    # it (the centrally differenced five-section file holds 3e-10 m/m).
     tip_dL = get("tip_dL").copy()
     tip_dL[:, 1] = 0.0
     return ModalTables(r["L_grid"].astype(float), coef, get("tip_static"), tip_dL,
@@ -436,8 +610,17 @@ class ModalROM:
 def check_params(p) -> None:
     """Raise ValueError if TelescopicParams p differ from the table build in anything the ROM
     does not interpolate (only payload, luffing angle, stroke history and n_nodes may vary;
-    contact_distribution acts on outputs only when friction is off)."""
-    ref = TelescopicParams()
+    contact_distribution acts on outputs only when friction is off).  Tables exist for the
+    boom counts of TABLE_BOOMS with the synchronized drive."""
+    if p.n_booms not in TABLE_BOOMS:
+        raise ValueError(f"n_booms = {p.n_booms!r}: the modal tables are built for booms "
+                         f"{', '.join(str(k) for k in TABLE_BOOMS)} (allowed values); use the "
+                         "full model (model.reduction = 'none')")
+    if getattr(p, "mechanism", "synchronized") != "synchronized":
+        raise ValueError(f"mechanism = {p.mechanism!r}: the modal tables follow one stroke "
+                         "coordinate (allowed: 'synchronized'); use the full model "
+                         "(model.reduction = 'none')")
+    ref = table_params(p.n_booms)
     for k in ("n_booms", "boom_length", "L_h", "E", "rho", "rope_EA", "gravity", "filter_h",
               "sections", "torsion", "rope_elasticity", "flexible"):
         if not hasattr(ref, k):             # options of later sim_core versions
@@ -460,7 +643,7 @@ def simulate_modal(p, n_modes: int, t_end: float, n_output: int, dt_max: float =
     from sim_core.physics.drive_profiles import CubicSmoothstepSchedule
     from sim_core.result import Result
     check_params(p)
-    tb = tables_for(p.payload, p.luffing_angle_deg, n_modes)
+    tb = tables_for(p.payload, p.luffing_angle_deg, n_modes, n_booms=p.n_booms)
     sched = CubicSmoothstepSchedule(v_max=p.v_max, t_ramp=p.t_ramp, t_hold_end=p.t_hold_end,
                                     sign=p.direction, s0=p.stroke0)
     lo, hi = tb.L_range
@@ -502,22 +685,29 @@ def simulate_modal(p, n_modes: int, t_end: float, n_output: int, dt_max: float =
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--build", action="store_true", help="(re)build the tables")
-    ap.add_argument("--quick", action="store_true", help="one configuration (25 t, 60 deg) only")
-    ap.add_argument("--out", default=str(DATA))
+    ap.add_argument("--booms", type=int, default=3, choices=sorted(TABLE_BOOMS),
+                    help="sections of the crane (synchronized drive; default: %(default)s)")
+    ap.add_argument("--quick", action="store_true",
+                    help="one configuration (the middle payload, 60 deg) only")
+    ap.add_argument("--out", default=None,
+                    help="tables file (default: data/modal_telescopic.npz for 3 booms, "
+                         "data/modal_telescopic_<N>.npz otherwise)")
     ap.add_argument("--angles", type=float, nargs="+", default=list(ANGLES),
                     help="luffing angles, deg (default: %(default)s)")
-    ap.add_argument("--payloads", type=float, nargs="+", default=list(PAYLOADS),
-                    help="payload masses, kg (default: %(default)s)")
+    ap.add_argument("--payloads", type=float, nargs="+", default=None,
+                    help="payload masses, kg (default: 20 25 30 t for 3 booms, 5 10 15 t for 5)")
     ap.add_argument("--reuse", nargs="+", default=None,
                     help="existing tables file(s) whose configurations are copied, not rebuilt "
                          "(also merges per-angle builds)")
     a = ap.parse_args(argv)
+    payloads = tuple(sorted(a.payloads or TABLE_BOOMS[a.booms]))
     if a.build:
         if a.quick:
-            build_tables(a.out, payloads=(25000.0,), angles=(60.0,))
+            build_tables(a.out, payloads=(payloads[len(payloads) // 2],), angles=(60.0,),
+                         n_booms=a.booms)
         else:
-            build_tables(a.out, payloads=tuple(sorted(a.payloads)), angles=tuple(sorted(a.angles)),
-                         reuse=a.reuse)
+            build_tables(a.out, payloads=payloads, angles=tuple(sorted(a.angles)),
+                         reuse=a.reuse, n_booms=a.booms)
     else:
         ap.print_help()
 

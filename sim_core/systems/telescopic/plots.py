@@ -30,14 +30,42 @@ def _times(t: np.ndarray, wanted) -> list[int]:
     return idx
 
 
+def _drive(result: Result) -> tuple[int, str]:
+    """(number of booms, drive mechanism) of the result's scene (the paper's 3, synchronized
+    where the scene does not say)."""
+    sc = result.scene
+    n = 3
+    for table in ("booms", "params"):
+        if isinstance(sc.get(table), dict):
+            n = int(sc[table].get("count", sc[table].get("n_booms", n)))
+    mech = "synchronized"
+    for table, key in (("drive", "mechanism"), ("params", "mechanism")):
+        if isinstance(sc.get(table), dict) and key in sc[table]:
+            mech = str(sc[table][key])
+    return n, mech
+
+
+def rigid_tip_travel(result: Result) -> np.ndarray:
+    """Travel of the tip along the boom axis in the rigid limit of the scene's drive (m, per
+    output): synchronized, every one of the N - 1 stages moves with the prescribed piston stroke
+    s (Eqs. 74-76 for N = 3: boom 3 moves 2 s); sequential, the prescribed stage strokes add."""
+    n, mech = _drive(result)
+    if mech == "sequential" and "stage_stroke" in result:
+        return np.sum(result["stage_stroke"], axis=1)
+    return (n - 1) * np.asarray(result["piston_stroke"], float)
+
+
 def plot_telescopic(result: Result, out: str | Path, slider_times=None) -> list[Path]:
-    """The telescopic figures of Zhao-Qi-Wang 2024 Section 9:
+    """The telescopic figures of Zhao-Qi-Wang 2024 Section 9, for every overlap of N booms:
 
     * ``tip_rigid_limit.png`` (Figs. 14-17): tip X and Z and their rates against the rigid-boom
-      kinematics tip_0 + 2 s(t) (cos theta, sin theta) (Eqs. 74-76: boom 3 moves twice the
-      piston stroke s), and the difference (the flexible deflection and the rope stretch);
+      kinematics tip_0 + travel(t) (cos theta, sin theta) (:func:`rigid_tip_travel`; Eqs. 74-76:
+      boom 3 moves twice the piston stroke s), and the difference (the flexible deflection and
+      the rope stretch);
     * ``contact_point_forces.png`` (Figs. 22-25): force and moment components (section frame:
-      axial s, lateral t, vertical b) at the inner and outer contact points of every pair;
+      axial s, lateral t, vertical b) at the inner and outer contact points, one row per overlap;
+    * ``drive_forces.png``: the force of every cylinder (or locked stage) and the tension of
+      every rope;
     * ``slider_contact_forces.png`` (Fig. 26): normal force of every slider spring of every
       region at chosen times (default: t_end / 4, t_end / 2, 0.8 t_end = 16 s of the paper's
       20 s, t_end), springs numbered arc by arc as in ``sim_core.physics.contact``.
@@ -54,9 +82,9 @@ def plot_telescopic(result: Result, out: str | Path, slider_times=None) -> list[
         e = np.array([np.cos(np.radians(theta)), np.sin(np.radians(theta))])
         tip = result["tip_position"][:, [0, 2]]
         vel = result["tip_velocity"][:, [0, 2]]
-        s = result["piston_stroke"]
-        rigid = tip[0] + 2.0 * s[:, None] * e
-        rigid_rate = 2.0 * np.gradient(s, t)[:, None] * e
+        s = rigid_tip_travel(result)
+        rigid = tip[0] + s[:, None] * e
+        rigid_rate = np.gradient(s, t)[:, None] * e
         fig, axes = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
         for c, lab in enumerate("XZ"):
             axes[0].plot(t, tip[:, c], label=f"{lab} flexible")
@@ -78,32 +106,60 @@ def plot_telescopic(result: Result, out: str | Path, slider_times=None) -> list[
         plt.close(fig)
     if "contact_point_forces" in result:
         cpf = result["contact_point_forces"]            # (n, pairs, 2, 6)
-        fig, axes = plt.subplots(2, 2, figsize=(11, 7), sharex=True)
+        n_pairs = cpf.shape[1]
+        fig, axes = plt.subplots(n_pairs, 4, figsize=(14, 2.6 * n_pairs + 0.8), sharex=True,
+                                 squeeze=False)
         comps = ("s", "t", "b")
-        for k in range(cpf.shape[1]):
-            for j, where in enumerate((f"inner, boom {k + 1}", f"outer, boom {k + 2}")):
+        for k in range(n_pairs):
+            for j, where in enumerate((f"I_{k + 1}{k + 2} (inner, boom {k + 1})",
+                                       f"II_{k + 1}{k + 2} (outer, boom {k + 2})")):
                 for c in range(3):
-                    axes[0, j].plot(t, cpf[:, k, j, c] / 1e3, label=f"f_{comps[c]} {where}")
-                    axes[1, j].plot(t, cpf[:, k, j, 3 + c] / 1e3, label=f"m_{comps[c]} {where}")
-        for j, title in enumerate(("inner contact points (region I)",
-                                   "outer contact points (region II)")):
-            axes[0, j].set_title(title, fontsize=10)
-            axes[0, j].set_ylabel("force [kN]")
-            axes[1, j].set_ylabel("moment [kN m]")
-            axes[1, j].set_xlabel("t [s]")
+                    axes[k, 2 * j].plot(t, cpf[:, k, j, c] / 1e3, label=f"f_{comps[c]}")
+                    axes[k, 2 * j + 1].plot(t, cpf[:, k, j, 3 + c] / 1e3, label=f"m_{comps[c]}")
+                axes[k, 2 * j].set_title(f"{where}: force", fontsize=9)
+                axes[k, 2 * j + 1].set_title(f"{where}: moment", fontsize=9)
+                axes[k, 2 * j].set_ylabel("kN")
+                axes[k, 2 * j + 1].set_ylabel("kN m")
+        for ax in axes[-1]:
+            ax.set_xlabel("t [s]")
         for ax in axes.ravel():
             ax.grid(alpha=0.3)
-            ax.legend(loc="best", fontsize=6, ncol=2)
+            ax.legend(loc="best", fontsize=6)
         fig.suptitle("constraint reactions at the contact points (section frame)")
         fig.tight_layout()
         paths.append(save_figure(fig, out / "contact_point_forces.png"))
+        plt.close(fig)
+    if "drive_forces" in result and "stage_stroke" in result:
+        n, mech = _drive(result)
+        from sim_core.systems.telescopic.build import drive_layout, drive_name
+        names = [drive_name(k, mech) for k in drive_layout(n, mech)[0]]
+        fig, axes = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
+        for name, f in zip(names, np.asarray(result["drive_forces"]).T):
+            axes[0].plot(t, f / 1e3, label=name)
+        for k, s in enumerate(np.asarray(result["stage_stroke"]).T):
+            axes[1].plot(t, s, label=f"stage {k + 1}-{k + 2}")
+        if "rope_tensions" in result:
+            _, ropes = drive_layout(n, mech)
+            for i, T in enumerate(np.asarray(result["rope_tensions"]).T):
+                kind = ("extraction", "retraction")[i % 2]
+                axes[2].plot(t, T / 1e3, label=f"{kind} rope, boom {ropes[i // 2] + 1}")
+        axes[0].set_ylabel("drive force [kN]")
+        axes[1].set_ylabel("stage stroke [m]")
+        axes[2].set_ylabel("rope tension [kN]")
+        axes[2].set_xlabel("t [s]")
+        for ax in axes:
+            ax.grid(alpha=0.3)
+            ax.legend(loc="best", fontsize=7)
+        fig.suptitle(f"{mech} drive of {n} booms (forces positive = pushing)")
+        fig.tight_layout()
+        paths.append(save_figure(fig, out / "drive_forces.png"))
         plt.close(fig)
     if "slider_contact_forces" in result:
         sf = result["slider_contact_forces"]            # (n, regions, springs)
         wanted = slider_times if slider_times is not None else \
             [t[-1] / 4, t[-1] / 2, 0.8 * t[-1], t[-1]]
         idx = _times(t, wanted)
-        names = ["I_12", "II_12", "I_23", "II_23"][:sf.shape[1]]
+        names = [f"{r}_{k + 1}{k + 2}" for k in range(sf.shape[1] // 2) for r in ("I", "II")]
         fig, axes = plt.subplots(len(names), 1, figsize=(9, 2.2 * len(names)), sharex=True)
         axes = np.atleast_1d(axes)
         for r, (ax, name) in enumerate(zip(axes, names)):

@@ -4,12 +4,17 @@
   [solver]     t_end s (> 0), rtol (0, 1), atol (> 0), n_output (>= 2), method ("RK45", "BDF",
                "auto"), max_step s and max_wall_s s (> 0, optional; max_wall_s: wall-clock budget,
                stops with a partial result)
-  [booms]      count (2..3; ropes only for 3), length m (> 0), luffing_angle_deg (0..85),
+  [booms]      count (2..6: the paper's three booms are the innermost three, larger sections
+               of the same family outside them, params.crane_sections), length m (> 0),
+               luffing_angle_deg (0..85),
                stroke0 m (piston-rod length L_s at t = 0, > 0), L_h m (luffing point on boom 1,
                within (0, length)), E Pa (> 0), rho kg/m^3 (> 0), n_nodes (3..33 per spline
                element; paper 9), n_gauss (1..10)
   [drive]      direction ("extraction"/"retraction"), v_max m/s (> 0), t_ramp s (> 0),
-               t_hold_end s (>= t_ramp)  -- the cubic schedule of Section 9 (SCENARIOS A4)
+               t_hold_end s (>= t_ramp)  -- the cubic schedule of Section 9 (SCENARIOS A4);
+               mechanism ("synchronized" default: the paper's cylinder-and-rope unit repeated
+               along the boom, every stage moves together; "sequential": one cylinder moves
+               one stage at a time, the others pinned; docs/model.md, "N-boom drives")
   [payload]    mass kg (>= 0)
   [ropes]      EA N (> 0)
   [effects]    what is off is not built (each a separate contribution to the model):
@@ -43,8 +48,9 @@
   [filtering]  h s (> 0)
   [gravity]    g m/s^2 (> 0, along -Z)
   [model]      reduction ("none" = full model, "modal" = stroke-parametric modal ROM of
-               sim_core.systems.telescopic.modal, tables built from the full model), n_modes (1..4,
-               in-plane modes kept by the ROM; default 3)
+               sim_core.systems.telescopic.modal, tables built from the full model for 3 and 5
+               booms, synchronized drive, frictionless), n_modes (1..4, in-plane modes kept by
+               the ROM; default 3)
 Geometry rules: the stroke history must keep each boom inside its neighbour: with L_s(t) the
 piston length, 0 < L_s(t) < length for all t in [0, t_end] (error names drive/booms fields).
 """
@@ -55,7 +61,7 @@ from typing import Any
 
 from sim_core.errors import SceneError
 from sim_core.scene.fields import ERROR_CONTROLLED, boolean, check_keys, choice, number, solver_table
-from sim_core.systems.telescopic.params import TelescopicParams
+from sim_core.systems.telescopic.params import MAX_BOOMS, MECHANISMS, TelescopicParams
 
 _TOP = {"kind", "name", "description", "solver", "booms", "drive", "payload", "ropes", "effects",
         "filtering", "gravity", "contact", "notes", "model"}
@@ -71,15 +77,7 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
     check_keys(b, {"count", "length", "luffing_angle_deg", "stroke0", "L_h", "E", "rho",
                    "n_nodes", "n_gauss"}, "booms")
     L = number(b, "length", "booms", 10.0, lo=0.0, lo_open=True)
-    count = b.get("count", 3)
-    if isinstance(count, int) and not isinstance(count, bool) and count > 3:
-        # the paper's drive (one telescopic cylinder between booms 1 and 2, the rope pair that
-        # moves boom 3 with it, Section 2 and 9) moves three booms; four or more sections need
-        # a drive mechanism of their own (synchronized or sequential), not modelled
-        raise SceneError(f"booms.count = {count}: the paper's single-cylinder-and-rope drive "
-                         "moves at most 3 booms; sections 4 and beyond have no drive in this "
-                         "model and the statics fail (allowed: 2 or 3)")
-    sc["booms"] = {"count": number(b, "count", "booms", 3, lo=2, hi=3, integer=True),
+    sc["booms"] = {"count": number(b, "count", "booms", 3, lo=2, hi=MAX_BOOMS, integer=True),
                    "length": L,
                    "luffing_angle_deg": number(b, "luffing_angle_deg", "booms", 60.0, lo=0.0, hi=85.0),
                    "stroke0": number(b, "stroke0", "booms", 2.0, lo=0.0, hi=L, lo_open=True, hi_open=True),
@@ -89,12 +87,13 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
                    "n_nodes": number(b, "n_nodes", "booms", 9, lo=3, hi=33, integer=True),
                    "n_gauss": number(b, "n_gauss", "booms", 5, lo=1, hi=10, integer=True)}
     d = raw.get("drive", {})
-    check_keys(d, {"direction", "v_max", "t_ramp", "t_hold_end"}, "drive")
+    check_keys(d, {"direction", "v_max", "t_ramp", "t_hold_end", "mechanism"}, "drive")
     t_ramp = number(d, "t_ramp", "drive", 4.0, lo=0.0, lo_open=True)
     sc["drive"] = {"direction": choice(d, "direction", "drive", ("extraction", "retraction"), "extraction"),
                    "v_max": number(d, "v_max", "drive", 0.5, lo=0.0, lo_open=True),
                    "t_ramp": t_ramp,
-                   "t_hold_end": number(d, "t_hold_end", "drive", 12.0, lo=t_ramp)}
+                   "t_hold_end": number(d, "t_hold_end", "drive", 12.0, lo=t_ramp),
+                   "mechanism": choice(d, "mechanism", "drive", MECHANISMS, "synchronized")}
     travel = sc["drive"]["v_max"] * sc["drive"]["t_hold_end"]
     sign = 1 if sc["drive"]["direction"] == "extraction" else -1
     end = sc["booms"]["stroke0"] + sign * travel
@@ -127,9 +126,11 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
                          f"{sc['booms']['count']}: the slider geometry is the paper's three-boom "
                          "section (allowed: booms.count = 3, or contact_distribution = false)")
     if not eff["flexible"]:
-        if sc["booms"]["count"] not in (2, 3):
-            raise SceneError(f"effects.flexible = false with booms.count = {sc['booms']['count']}: "
-                             "the rigid limit has the paper's drive (allowed: 2 or 3)")
+        if sc["booms"]["count"] not in (2, 3) or sc["drive"]["mechanism"] != "synchronized":
+            raise SceneError(f"effects.flexible = false with booms.count = {sc['booms']['count']} "
+                             f"and drive.mechanism = {sc['drive']['mechanism']!r}: the kinematic "
+                             "rigid limit has the paper's drive (allowed: booms.count 2 or 3, "
+                             "mechanism 'synchronized'; for more sections take a large booms.E)")
         if eff["friction"]:
             raise SceneError("effects.friction = true with effects.flexible = false: rigid contact "
                              "reactions are statically indeterminate (allowed: friction = false)")
@@ -188,6 +189,17 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
         raise SceneError(f"model.reduction = 'modal' with contact.moment_model = "
                          f"{sc['contact']['moment_model']!r}: the modal tables are built with the "
                          "rigid contact sections (allowed: 'rigid')")
+    if sc["model"]["reduction"] == "modal" and sc["drive"]["mechanism"] != "synchronized":
+        raise SceneError(f"model.reduction = 'modal' with drive.mechanism = "
+                         f"{sc['drive']['mechanism']!r}: the modal tables follow one stroke "
+                         "coordinate (allowed: 'synchronized')")
+    if sc["model"]["reduction"] == "modal":
+        from sim_core.systems.telescopic.modal import TABLE_BOOMS
+        if sc["booms"]["count"] not in TABLE_BOOMS:
+            raise SceneError(f"model.reduction = 'modal' with booms.count = "
+                             f"{sc['booms']['count']}: modal tables exist for booms.count "
+                             f"{' or '.join(map(str, TABLE_BOOMS))} (allowed values; other counts: "
+                             "model.reduction = 'none')")
     if sc["model"]["reduction"] == "modal" and sc["effects"]["friction"]:
         raise SceneError("model.reduction = 'modal' with effects.friction = true: the modal tables "
                          "are frictionless; set effects.friction = false")
@@ -204,6 +216,7 @@ def params_from_scene(sc: dict):
         gravity=sc["gravity"]["g"] if sc["effects"]["gravity"] else 0.0, n_nodes=b["n_nodes"],
         n_gauss=b["n_gauss"], filter_h=sc["filtering"]["h"] if sc["effects"]["filtering"] else 0.0,
         v_max=d["v_max"], t_ramp=d["t_ramp"], t_hold_end=d["t_hold_end"],
+        mechanism=d["mechanism"],
         friction=sc["effects"]["friction"], mu_static=sc["contact"]["mu_static"],
         mu_dynamic=sc["contact"]["mu_dynamic"], v_eps=sc["contact"]["v_eps"],
         spring_k0=sc["contact"]["k0"], spring_eps=sc["contact"]["eps"],

@@ -1,0 +1,76 @@
+"""The machine state a benchmark table states: processor, cores and affinity, each core's busy
+share during the run (/proc/stat), load average, versions, commit and time."""
+
+from __future__ import annotations
+
+import datetime
+import os
+import platform
+import subprocess
+
+import numpy as np
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
+
+
+def cpu_times() -> dict[int, tuple[int, int]]:
+    """(busy, total) jiffies of each core (/proc/stat); empty where not available."""
+    out = {}
+    try:
+        with open("/proc/stat") as f:
+            for line in f:
+                if line.startswith("cpu") and line[3].isdigit():
+                    parts = line.split()
+                    v = [int(x) for x in parts[1:]]
+                    idle = v[3] + (v[4] if len(v) > 4 else 0)
+                    out[int(parts[0][3:])] = (sum(v[:8]) - idle, sum(v[:8]))
+    except OSError:
+        pass
+    return out
+
+
+def commit() -> str:
+    """Short commit of the working tree, marked where it has uncommitted changes."""
+    try:
+        rev = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT,
+                             capture_output=True, text=True, timeout=10,
+                             check=False).stdout.strip()
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"],
+                               cwd=ROOT, capture_output=True, text=True, timeout=10,
+                               check=False).stdout
+        return rev + (" (with uncommitted changes)" if dirty.strip() else "")
+    except (OSError, subprocess.SubprocessError):
+        return "unknown"
+
+
+def machine_lines(cpu0, cpu1, load0, load1) -> list[str]:
+    """Markdown bullets of the machine state between two (cpu_times(), os.getloadavg())."""
+    model = platform.processor() or ""
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    model = line.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    aff = sorted(os.sched_getaffinity(0))
+    busy = []
+    for c in sorted(cpu1):
+        if c in cpu0 and cpu1[c][1] > cpu0[c][1]:
+            share = (cpu1[c][0] - cpu0[c][0]) / (cpu1[c][1] - cpu0[c][1])
+            who = "this benchmark" if aff == [c] else "other processes"
+            busy.append(f"core {c} {100 * share:.0f} % ({who}"
+                        + ("" if aff == [c] else ": " + ("busy" if share > 0.5 else "idle"))
+                        + ")")
+    return [f"- CPU: {model}; {os.cpu_count()} logical processors; this run pinned to "
+            f"{'core ' + str(aff[0]) if len(aff) == 1 else 'cores ' + str(aff)}"
+            + (" (`taskset -c 0`)" if aff == [0] else " (NOT pinned to one core)"),
+            "- busy share of each core during the run: " + ", ".join(busy) if busy else
+            "- busy share of each core: not available",
+            f"- load average (1, 5, 15 min) before: {load0[0]:.2f}, {load0[1]:.2f}, "
+            f"{load0[2]:.2f}; after: {load1[0]:.2f}, {load1[1]:.2f}, {load1[2]:.2f}",
+            f"- Python {platform.python_version()}, numpy {np.__version__}, "
+            f"{platform.platform()}",
+            f"- commit {commit()}",
+            f"- {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC"]
