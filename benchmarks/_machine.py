@@ -43,17 +43,21 @@ def commit() -> str:
         return "unknown"
 
 
-def machine_lines(cpu0, cpu1, load0, load1) -> list[str]:
-    """Markdown bullets of the machine state between two (cpu_times(), os.getloadavg())."""
-    model = platform.processor() or ""
+def cpu_model() -> str:
+    """The processor's model name (/proc/cpuinfo, else platform.processor())."""
     try:
         with open("/proc/cpuinfo") as f:
             for line in f:
                 if line.startswith("model name"):
-                    model = line.split(":", 1)[1].strip()
-                    break
+                    return line.split(":", 1)[1].strip()
     except OSError:
         pass
+    return platform.processor() or ""
+
+
+def machine_lines(cpu0, cpu1, load0, load1) -> list[str]:
+    """Markdown bullets of the machine state between two (cpu_times(), os.getloadavg())."""
+    model = cpu_model()
     aff = sorted(os.sched_getaffinity(0))
     busy = []
     for c in sorted(cpu1):

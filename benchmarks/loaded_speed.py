@@ -55,6 +55,7 @@ import time
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
 sys.path.insert(0, ROOT)
 
+from benchmarks._machine import commit, cpu_model  # noqa: E402
 from sim_core import load_scene  # noqa: E402
 from sim_core.result import atomic_write_bytes  # noqa: E402
 
@@ -132,30 +133,10 @@ def _stats(values: list[float]) -> tuple[float, float, float]:
 
 
 def _machine() -> list[str]:
-    try:
-        aff = sorted(os.sched_getaffinity(0))
-    except AttributeError:                      # pragma: no cover
-        aff = list(range(os.cpu_count() or 1))
-    model = platform.processor() or ""
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    model = line.split(":", 1)[1].strip()
-                    break
-    except OSError:
-        pass
-    try:
-        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT,
-                                capture_output=True, text=True, timeout=10).stdout.strip()
-        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"],
-                               cwd=ROOT, capture_output=True, text=True, timeout=10).stdout
-        commit += " (with uncommitted changes)" if dirty.strip() else ""
-    except (OSError, subprocess.SubprocessError):
-        commit = "unknown"
-    return [f"- CPU: {model}; {os.cpu_count()} logical processors, affinity {aff}",
+    aff = sorted(os.sched_getaffinity(0))
+    return [f"- CPU: {cpu_model()}; {os.cpu_count()} logical processors, affinity {aff}",
             f"- Python {platform.python_version()}, {platform.platform()}",
-            f"- commit {commit}",
+            f"- commit {commit()}",
             f"- {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC"]
 
 

@@ -19,6 +19,16 @@ def _luffing_angle(result: Result) -> float | None:
     return None
 
 
+def _label_stack(axes, ylabels) -> None:
+    """y labels, grid and legends of a column of panels over a shared time axis."""
+    for ax, label in zip(axes, ylabels):
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3)
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(loc="best", fontsize=7)
+    axes[-1].set_xlabel("t [s]")
+
+
 def _times(t: np.ndarray, wanted) -> list[int]:
     """Output indices nearest to the wanted times inside the run (no duplicates)."""
     idx = []
@@ -92,13 +102,7 @@ def plot_telescopic(result: Result, out: str | Path, slider_times=None) -> list[
             axes[1].plot(t, vel[:, c], label=f"d{lab}/dt flexible")
             axes[1].plot(t, rigid_rate[:, c], "--", label=f"d{lab}/dt rigid limit")
             axes[2].plot(t, 1e3 * (tip[:, c] - rigid[:, c]), label=f"{lab} - rigid")
-        axes[0].set_ylabel("tip [m]")
-        axes[1].set_ylabel("tip rate [m/s]")
-        axes[2].set_ylabel("flexible - rigid [mm]")
-        axes[2].set_xlabel("t [s]")
-        for ax in axes:
-            ax.grid(alpha=0.3)
-            ax.legend(loc="best", fontsize=7)
+        _label_stack(axes, ("tip [m]", "tip rate [m/s]", "flexible - rigid [mm]"))
         fig.suptitle(f"tip (top centre of the innermost boom) vs rigid-boom kinematics, "
                      f"luffing {theta:g} deg")
         fig.tight_layout()
@@ -143,13 +147,7 @@ def plot_telescopic(result: Result, out: str | Path, slider_times=None) -> list[
             for i, T in enumerate(np.asarray(result["rope_tensions"]).T):
                 kind = ("extraction", "retraction")[i % 2]
                 axes[2].plot(t, T / 1e3, label=f"{kind} rope, boom {ropes[i // 2] + 1}")
-        axes[0].set_ylabel("drive force [kN]")
-        axes[1].set_ylabel("stage stroke [m]")
-        axes[2].set_ylabel("rope tension [kN]")
-        axes[2].set_xlabel("t [s]")
-        for ax in axes:
-            ax.grid(alpha=0.3)
-            ax.legend(loc="best", fontsize=7)
+        _label_stack(axes, ("drive force [kN]", "stage stroke [m]", "rope tension [kN]"))
         fig.suptitle(f"{mech} drive of {n} booms (forces positive = pushing)")
         fig.tight_layout()
         paths.append(save_figure(fig, out / "drive_forces.png"))
