@@ -73,7 +73,7 @@ The deflection is the tip position (innermost boom N = ``booms``, s = 10 m) minu
 static-equilibrium tip of the same model at the current L_s (tables of the full model), i.e. the
 vibration plus the quasi-static inertial deflection.  With ``fidelity="paper"`` the reference is
 the full model's own equilibrium tip at reset moved by the tables' static tip change (the tables
-interpolate across the retraction rope's slack/taut switch near L_s = 2 m, ~1 mm off there).
+interpolate linearly between their stroke grid points, ~0.02 mm off the model's equilibrium).
 Deflections are mm-scale (cm with ``booms=5``): normalise observations (e.g. VecNormalize)
 for learning.  A deflection outside its bounds counts as divergence.
 
@@ -481,8 +481,8 @@ class TelescopicBoomEnv(gym.Env):
         for c in self._cyls:
             c.target = self._target
         # deflection reference: the model's own equilibrium tip at the start, moved with the
-        # tables' static tip (the tables interpolate across the retraction rope's slack/taut
-        # switch near L_s = 2 m: ~1 mm off there, more than the dynamic response)
+        # tables' static tip (interpolated between the stroke grid points, ~0.02 mm off the
+        # model's equilibrium at other strokes)
         self._tip_offset = self._paper_tip()[0] - self.tables.static_tip(L0)[0]
 
     def _target(self, t):

@@ -23,9 +23,8 @@ discretisation (n_nodes = 3 per spline element, frictionless resultants, stress 
    ``stroke_ref`` (the physical ropes of the scene; their lengths are stroke invariant,
    SCENARIOS A3);
 2. the reduced tangent stiffness K = -d(F_r + C^T lambda)/dz (``tangent_stiffness``: central
-   differences, step 1e-8 max(1, max|z|), symmetrised; the three-boom file was built with
-   forward differences, step 1e-7; constraint multipliers frozen: geometric stiffness of the
-   constraints included), the reduced damping
+   differences, step 1e-8 max(1, max|z|), symmetrised; constraint multipliers frozen: geometric
+   stiffness of the constraints included), the reduced damping
    D = -dF_r/dz_dot (stress-filter damping, second seed Eq. 53) and the reduced mass M_r (with
    the filter's (h^2/6) K mass term) are evaluated about z_s;
 3. constrained modes: K N x = omega^2 M_r N x on the null space N of the constraint Jacobian
@@ -271,14 +270,13 @@ def tangent_stiffness(parts, z, lam, rel_step=K_REL_STEP, central=True, symmetri
     (truncation error h^2/6 times the third derivative of the potential).  The step matters:
     a tension-only rope near zero tension has its slack kink (a C1 ramp over slack_width =
     1e-6 m, point_effects.RopeDrive) within micrometres of the equilibrium, and forward
-    differences with h = 1e-7 max|z| (2.3e-6 at five booms) gave K an asymmetry of
-    7e-4 max|K| there: at five booms, 75 deg, 5 t, L_s = 3.05 m the third in-plane mode moved
-    from 4.40 to 5.05 Hz and the tip slope of the stroke tangent from 4.00 to 3.54 m/m (the
-    first mode by 2e-6).  The exact K is symmetric (conservative elastic, gravity, rope and
-    constraint forces), so the asymmetric part of the differenced K measures its error: 3e-9
-    max|K| with the default step there.  ``central=False``, ``rel_step=1e-7``: the forward
-    differences the three-boom tables were built with.  ``symmetrise=False``: the differenced
-    K as it is (for its error estimate)."""
+    differences with h = 1e-7 max|z| (2.3e-6 at five booms) give K an asymmetry of
+    7e-4 max|K| there: at five booms, 75 deg, 5 t, L_s = 3.05 m the third in-plane mode moves
+    from 4.40 to 5.05 Hz and the tip slope of the stroke tangent from 4.00 to 3.54 m/m.  The
+    exact K is symmetric (conservative elastic, gravity, rope and constraint forces), so the
+    asymmetric part of the differenced K measures its error: 3e-9 max|K| with the default step
+    there.  ``central=False``, ``rel_step=1e-7``: forward differences (for that comparison).
+    ``symmetrise=False``: the differenced K as it is (for its error estimate)."""
     n = len(z)
     f0, C0 = parts(z)
     r0 = f0 + C0.T @ lam
@@ -537,10 +535,8 @@ def tables_for(payload: float, angle_deg: float, n_modes: int = N_MODES_TABLE,
 
     coef = np.stack([get(k)[:, :n_modes] for k in COLS], axis=1)
     # the scene is symmetric about the luffing plane: the static tip has no lateral (Y) part and
-    # neither has its stroke derivative.  The Y derivative of the three-boom file (up to 0.25 m/m
-    # at 8.25 m) is the error of its forward-difference K (tangent_stiffness) amplified by the
-    # implicit-function solve through the soft lateral / torsion directions, not physics: drop
-    # it (the centrally differenced five-section file holds 3e-10 m/m).
+    # neither has its stroke derivative: the tables' Y derivative is differencing noise (below
+    # 1e-6 m/m with the central-difference K of tangent_stiffness) and is set to zero.
     tip_dL = get("tip_dL").copy()
     tip_dL[:, 1] = 0.0
     return ModalTables(r["L_grid"].astype(float), coef, get("tip_static"), tip_dL,
