@@ -19,6 +19,7 @@ thread).  From the repository root:
     taskset -c 0 python benchmarks/cantilever_accuracy.py --case rk45      # ~20 s
     taskset -c 0 python benchmarks/cantilever_accuracy.py --profile        # per-step costs
     taskset -c 0 python benchmarks/cantilever_accuracy.py --table          # ~3-4 min
+    taskset -c 0 python benchmarks/cantilever_accuracy.py --adaptive       # error-controlled
 
 ``--case TOL`` (1e-3, 1e-4, 1e-5, 1e-6) loads the scene with the setting's overrides, runs
 :func:`sim_core.simulate` once (the compiled functions load from numba's cache), then
@@ -35,6 +36,14 @@ sub-elements x 5 Gauss points) for comparison, one run after a 0.01 s warm-up.
 compiled loop per step, one residual and one tangent (M, K, C and the inverse iteration matrix)
 called from Python, and the sections of scene -> Result.
 
+``--adaptive`` measures the error-controlled generalized-alpha (the beam scenes' default: no
+solver.h) for the 1e-4 and 1e-5 settings' meshes and rho_inf: the loosest rtol on the grid
+10^(-k/4) (atol = rtol x 0.01 m, the deflection's scale) whose tip error at the outputs and
+that of the two next tighter rtol meet the tolerance, then min / median of ``--repeat`` timed
+runs after a warm-up, as ``--case``; it rewrites only the section "Error-controlled steps"
+at the end of the report, with its own machine state (the fixed-step table above it is one
+earlier run).
+
 ``--table`` runs every case and the profile in child processes (which inherit this process's
 CPU affinity), times the whole process of ``--case 1e-4 --repeat 1`` and ``--case 1e-5
 --repeat 1`` (``--whole-runs`` runs after one warm-up; or takes those figures from
@@ -46,11 +55,9 @@ cores, affinity, load average, and each core's busy share during the run (/proc/
 from __future__ import annotations
 
 import argparse
-import datetime
 import json
 import math
 import os
-import platform
 import statistics
 import subprocess
 import sys
@@ -61,6 +68,7 @@ sys.path.insert(0, ROOT)
 
 import numpy as np  # noqa: E402
 
+from benchmarks._machine import cpu_times, machine_lines  # noqa: E402
 from sim_core import load_scene, simulate  # noqa: E402
 from sim_core.result import atomic_write_bytes  # noqa: E402
 from sim_core.validation.closed_form import cantilever_release_tip  # noqa: E402
@@ -195,6 +203,109 @@ def run_case(case: str, repeat: int, once: bool = False, n_output: int | None = 
     return row
 
 
+ADAPTIVE_TOLS = ("1e-4", "1e-5")
+ADAPTIVE_SECTION = "## Error-controlled steps (the beam scenes' default)"
+
+
+def adaptive_scene(case: str, rtol: float, n_output: int = 401) -> dict:
+    """The scene on the setting's mesh and rho_inf without solver.h: error-controlled steps at
+    rtol, atol = rtol x 0.01 m, newton_atol = atol / 10 (the default)."""
+    from sim_core.registry import system_kind
+    from sim_core.scene.io import apply_overrides, read_scene
+    s = SETTINGS[case]
+    raw, source = read_scene(SCENE)
+    for key in ("h", "newton_atol"):
+        raw["solver"].pop(key, None)
+    raw = apply_overrides(raw, {"beams.0.n_nodes": s["n_sub"] + 1, "beams.0.n_gauss": s["n_gauss"],
+                                "solver.rho_inf": s["rho_inf"], "solver.rtol": rtol,
+                                "solver.atol": rtol * 0.01, "solver.n_output": n_output})
+    return system_kind(raw).validate(raw, source)
+
+
+def run_adaptive(case: str, repeat: int) -> dict:
+    """The loosest rtol = 10^(-k/4) meeting the case's tolerance (with the two next tighter
+    ones), then its timings (module doc)."""
+    tol = SETTINGS[case]["tol"]
+    simulate(adaptive_scene(case, 1e-4, n_output=11))          # load the compiled functions
+    errs, k = {}, 8
+    while k <= 40:
+        for j in (k, k + 1, k + 2):
+            if j not in errs:
+                errs[j] = tip_error(simulate(adaptive_scene(case, 10 ** (-j / 4))))
+        if all(errs[j] <= tol for j in (k, k + 1, k + 2)):
+            break
+        k += 1
+    rtol = 10 ** (-k / 4)
+    integ, s2r = [], []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        res = simulate(adaptive_scene(case, rtol))
+        s2r.append(time.perf_counter() - t0)
+        integ.append(res.stats["wall_time_s"])
+    st = res.stats
+    return {"case": case, "tol_m": tol, "rtol": rtol, "atol": rtol * 0.01,
+            "n_sub": SETTINGS[case]["n_sub"], "n_gauss": SETTINGS[case]["n_gauss"],
+            "n_dof": st["n_dof"], "rho_inf": st["rho_inf"], "n_output": len(res.t),
+            "steps": st["n_steps"], "rejected": st["n_rejected"], "n_rhs": st["n_rhs"],
+            "n_jac": st["n_jac"], "n_lu": st["n_lu"], "min_step_s": st["min_step_s"],
+            "max_step_s": st["max_step_s"], "compiled": st["compiled"],
+            "err_outputs_m": tip_error(res), "searched": {f"{10 ** (-j / 4):.3g}": e
+                                                          for j, e in sorted(errs.items())},
+            "integration_s": [min(integ), statistics.median(integ)],
+            "scene_to_result_s": [min(s2r), statistics.median(s2r)],
+            "affinity": sorted(os.sched_getaffinity(0))}
+
+
+def adaptive_section(repeat: int, out_path: str) -> int:
+    """Runs :func:`run_adaptive` for ADAPTIVE_TOLS in child processes and rewrites the report's
+    section ADAPTIVE_SECTION (module doc)."""
+    cpu0, load0 = cpu_times(), os.getloadavg()
+    rows = {c: _child(["--adaptive-case", c, "--repeat", str(repeat)]) for c in ADAPTIVE_TOLS}
+    for r in rows.values():
+        print(json.dumps(r), flush=True)
+    cpu1, load1 = cpu_times(), os.getloadavg()
+    fixed = {}
+    for c in ADAPTIVE_TOLS:
+        try:
+            fixed[c] = _child(["--case", c, "--repeat", str(repeat)])
+        except RuntimeError:
+            fixed[c] = None
+    tol_name = {"1e-4": "0.1 mm", "1e-5": "0.01 mm"}
+    L = [ADAPTIVE_SECTION, "",
+         "Written by `taskset -c 0 python benchmarks/cantilever_accuracy.py --adaptive` (a run "
+         "of its own, after the table above).  The beam scenes' default: generalized-alpha "
+         "without solver.h, the step chosen by the local error estimate e_q = c_q h² Δq̈ "
+         "(Zienkiewicz & Xie 1991 for generalized-alpha) against rtol and atol = rtol × 0.01 m "
+         "(`sim_core.integrate.driver._alpha_adaptive`), on the meshes and ρ∞ of the fixed-step "
+         "rows; rtol the loosest of 10^(−k/4) meeting the tolerance with the two next tighter "
+         f"ones.  Min / median of {repeat} timed runs after a warm-up, 401 outputs.  For "
+         "comparison the fixed-step row of the same tolerance, re-measured in this run "
+         "(`--case`).", "", "Machine:", "", *machine_lines(cpu0, cpu1, load0, load1), "",
+         "| tol | sub-el. × Gauss (DOF) | ρ∞ | rtol (atol) | steps (rejected) | step min – max (s) "
+         "| tangents / inverses | max tip error at outputs (m) | integration (s) "
+         "| scene → Result (s) | fixed h, same run: integration / scene → Result (s) |",
+         "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for c in ADAPTIVE_TOLS:
+        r, f = rows[c], fixed[c]
+        fx = (f"{f['integration_s'][1]:.3g} / {f['scene_to_result_s'][1]:.3g}"
+              if f else "–")
+        L.append(f"| {tol_name[c]} | {r['n_sub']} × {r['n_gauss']} ({r['n_dof']}) "
+                 f"| {r['rho_inf']:g} | {r['rtol']:.3g} ({r['atol']:.3g}) "
+                 f"| {r['steps']} ({r['rejected']}) "
+                 f"| {r['min_step_s']:.3g} – {r['max_step_s']:.3g} | {r['n_jac']} / {r['n_lu']} "
+                 f"| {r['err_outputs_m']:.3g} | **{_mm(r['integration_s'])}** "
+                 f"| {_mm(r['scene_to_result_s'])} | {fx} |")
+    L += ["", "Searched rtol → tip error (m): " + "; ".join(
+        f"{tol_name[c]}: " + ", ".join(f"{k} → {v:.2g}" for k, v in rows[c]["searched"].items())
+        for c in ADAPTIVE_TOLS) + "."]
+    text = open(out_path).read() if os.path.exists(out_path) else ""
+    if ADAPTIVE_SECTION in text:
+        text = text[:text.index(ADAPTIVE_SECTION)].rstrip("\n") + "\n"
+    atomic_write_bytes(out_path, (text + "\n" + "\n".join(L) + "\n").encode())
+    print(f"wrote {out_path}")
+    return 0
+
+
 def _best(f, n: int) -> float:
     best = math.inf
     for _ in range(n):
@@ -311,70 +422,12 @@ def _whole_process(command: str, runs: int) -> dict:
     return {"runs": runs, "wall_s": [min(walls), statistics.median(walls), max(walls)]}
 
 
-def _cpu_times() -> dict[int, tuple[int, int]]:
-    """(busy, total) jiffies of each core (/proc/stat)."""
-    out = {}
-    try:
-        with open("/proc/stat") as f:
-            for line in f:
-                if line.startswith("cpu") and line[3].isdigit():
-                    parts = line.split()
-                    v = [int(x) for x in parts[1:]]
-                    idle = v[3] + (v[4] if len(v) > 4 else 0)
-                    out[int(parts[0][3:])] = (sum(v[:8]) - idle, sum(v[:8]))
-    except OSError:
-        pass
-    return out
-
-
-def _machine(cpu0, cpu1, load0, load1) -> list[str]:
-    model = platform.processor() or ""
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    model = line.split(":", 1)[1].strip()
-                    break
-    except OSError:
-        pass
-    try:
-        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT,
-                                capture_output=True, text=True, timeout=10,
-                                check=False).stdout.strip()
-        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"],
-                               cwd=ROOT, capture_output=True, text=True, timeout=10,
-                               check=False).stdout
-        commit += " (with uncommitted changes)" if dirty.strip() else ""
-    except (OSError, subprocess.SubprocessError):
-        commit = "unknown"
-    aff = sorted(os.sched_getaffinity(0))
-    busy = []
-    for c in sorted(cpu1):
-        if c in cpu0 and cpu1[c][1] > cpu0[c][1]:
-            share = (cpu1[c][0] - cpu0[c][0]) / (cpu1[c][1] - cpu0[c][1])
-            who = "this benchmark" if aff == [c] else "other processes"
-            busy.append(f"core {c} {100 * share:.0f} % ({who}"
-                        + ("" if aff == [c] else ": " + ("busy" if share > 0.5 else "idle"))
-                        + ")")
-    return [f"- CPU: {model}; {os.cpu_count()} logical processors; this run pinned to "
-            f"{'core ' + str(aff[0]) if len(aff) == 1 else 'cores ' + str(aff)}"
-            + (" (`taskset -c 0`)" if aff == [0] else " (NOT pinned to one core)"),
-            "- busy share of each core during the run: " + ", ".join(busy) if busy else
-            "- busy share of each core: not available",
-            f"- load average (1, 5, 15 min) before: {load0[0]:.2f}, {load0[1]:.2f}, "
-            f"{load0[2]:.2f}; after: {load1[0]:.2f}, {load1[1]:.2f}, {load1[2]:.2f}",
-            f"- Python {platform.python_version()}, numpy {np.__version__}, "
-            f"{platform.platform()}",
-            f"- commit {commit}",
-            f"- {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC"]
-
-
 def _mm(v, digits=3) -> str:
     return f"{v[0]:.{digits}g} / {v[1]:.{digits}g}"
 
 
 def table(repeat: int, whole_runs: int, whole_file: str | None, out_path: str) -> int:
-    cpu0, load0 = _cpu_times(), os.getloadavg()
+    cpu0, load0 = cpu_times(), os.getloadavg()
     rows = {}
     for case in CASES:
         rows[case] = _child(["--case", case, "--repeat", str(repeat)])
@@ -391,7 +444,7 @@ def table(repeat: int, whole_runs: int, whole_file: str | None, out_path: str) -
             whole = json.load(f)
     else:
         whole = {c: _whole_process(c, whole_runs) for c in WHOLE_COMMANDS}
-    cpu1, load1 = _cpu_times(), os.getloadavg()
+    cpu1, load1 = cpu_times(), os.getloadavg()
 
     tol_name = {"1e-3": "1 mm", "1e-4": "0.1 mm", "1e-5": "0.01 mm", "1e-6": "1 µm"}
     L = ["# Released cantilever: time to accuracy of generalized-alpha", "",
@@ -402,7 +455,7 @@ def table(repeat: int, whole_runs: int, whole_file: str | None, out_path: str) -
          "`benchmarks/cantilever_accuracy.py` (its docstring says how each figure is taken); "
          "reproduce with `taskset -c 0 python benchmarks/cantilever_accuracy.py --table`, "
          "one row with `... --case 1e-4`.", "",
-         "Machine:", "", *_machine(cpu0, cpu1, load0, load1), "",
+         "Machine:", "", *machine_lines(cpu0, cpu1, load0, load1), "",
          "## Time to accuracy (one core)", "",
          f"Times are min / median of {repeat} in-process repetitions after one warm-up run "
          "(the compiled functions already loaded).  *Integration*: `result.stats"
@@ -518,6 +571,10 @@ def main(argv: list[str] | None = None) -> int:
     g.add_argument("--case", choices=CASES, help="one setting (tolerance in m) or rk45")
     g.add_argument("--profile", action="store_true", help="per-step costs of the scene")
     g.add_argument("--table", action="store_true", help="every case; writes the report")
+    g.add_argument("--adaptive", action="store_true",
+                   help="the error-controlled default; rewrites its section of the report")
+    g.add_argument("--adaptive-case", choices=ADAPTIVE_TOLS,
+                   help="one error-controlled setting (JSON line)")
     ap.add_argument("--repeat", type=int, default=5, help="timed repetitions (default 5)")
     ap.add_argument("--n-output", type=int,
                     help="with --case: this many outputs (default: every 4.6-5 ms)")
@@ -536,6 +593,11 @@ def main(argv: list[str] | None = None) -> int:
     if args.profile:
         print(json.dumps(profile()), flush=True)
         return 0
+    if args.adaptive_case:
+        print(json.dumps(run_adaptive(args.adaptive_case, args.repeat)), flush=True)
+        return 0
+    if args.adaptive:
+        return adaptive_section(args.repeat, args.out)
     return table(args.repeat, args.whole_runs, args.whole_process, args.out)
 
 

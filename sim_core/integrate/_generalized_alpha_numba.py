@@ -18,6 +18,18 @@ element batch, constant selecting boundary conditions):
   position increment over ``newton_atol`` (m) + 1e-15 |q| (the second term keeps the test above
   the coordinates' roundoff).
 
+Error-controlled steps (:func:`run_adaptive`, used where the scene gives no ``h``): the local
+position error e_q = c_q h² (q̈_{n+1} - q̈_n) of
+:mod:`sim_core.integrate.generalized_alpha` (the generalized-α form of the Newmark estimator
+of Zienkiewicz & Xie 1991), its RMS over atol + rtol max(|q_n|, |q_{n+1}|), accept at <= 1,
+h_new = h clip(safety err^(-1/3), fac_min, fac_max) with Gustafsson's predictive factor (as the
+numpy reference's controller).  The tangent (M, K, C) is kept apart
+from the inverse iteration matrix, so a new h costs one n x n inverse of
+S = M + β' h² K + γ' h C, not a tangent; h is kept where the controller proposes a factor in
+[1, 1.2) (RADAU5's rule, Hairer & Wanner, Solving ODEs II, Sect. IV.8).  Outputs come from the
+cubic Hermite interpolants of the step (q from (q, v), v from (v, q̈): the numpy reference's
+``_hermite``), so the steps are free of the output grid; the last step lands on t_end.
+
 The numpy reference is :func:`sim_core.integrate.generalized_alpha.integrate_generalized_alpha`
 with the same parameters (``tests/integrators/test_alpha_method.py`` compares both).
 """
@@ -29,7 +41,7 @@ import numpy as np
 from sim_core._numba import AVAILABLE, numba
 from sim_core.physics import _effects_numba as ec
 
-OK, NEWTON_FAILED = 0, 1            # return codes of run_steps
+OK, NEWTON_FAILED, STEP_TOO_SMALL, PAUSED = 0, 1, 2, 3   # return codes
 
 
 def _identity(f):
@@ -142,19 +154,14 @@ def run_steps(q, v, qdd, a, n_steps, h, am, af, beta, gamma, newton_atol, max_it
     N = Qp.shape[0]
     bq = beta * (1.0 - af) / (1.0 - am) * h * h
     bv = gamma * (1.0 - af) / (1.0 - am) * h
-    c = 1.0 / (1.0 - am)
     zeroN = np.zeros(N)
     Q = np.empty(N)
     Qd = np.empty(N)
     Qdd = np.empty(N)
-    r = np.empty(nr)
-    dx = np.empty(nr)
     x = np.empty(nr)
-    qb = np.empty(nr)
-    vb = np.empty(nr)
-    ac = np.empty(nr)
     qn = np.empty(nr)
     vn = np.empty(nr)
+    an = np.empty(nr)
     fresh = False           # tangent formed at the current accepted state
     have = carry[0] > 0.5   # Sinv valid
     eta = carry[1]
@@ -165,6 +172,8 @@ def run_steps(q, v, qdd, a, n_steps, h, am, af, beta, gamma, newton_atol, max_it
         A_out[0, i] = qdd[i]
     for step in range(n_steps):
         converged = False
+        iters = 0
+        rate = 0.0
         for attempt in range(2):
             if not have:
                 lift(q, Qp, rows, sgn, Q)
@@ -181,55 +190,14 @@ def run_steps(q, v, qdd, a, n_steps, h, am, af, beta, gamma, newton_atol, max_it
                 have = True
                 fresh = True
             for i in range(nr):
-                ac[i] = c * (af * qdd[i] - am * a[i])
-                qb[i] = q[i] + h * v[i] + h * h * ((0.5 - beta) * a[i] + beta * ac[i])
-                vb[i] = v[i] + h * ((1.0 - gamma) * a[i] + gamma * ac[i])
                 # predictor: q̈_{n+1} = q̈_n, or linear extrapolation 2 q̈_n - q̈_{n-1}
                 x[i] = qdd[i] + predictor * (qdd[i] - qdd_prev[i])
-            eta = max(eta, 2.2e-16) ** 0.8
-            dnorm_old = -1.0
-            rate = 0.0
-            ok = False
-            for k in range(max_iter):
-                stats[2] += 1
-                stats[1] += 1
-                for i in range(nr):
-                    qn[i] = qb[i] + bq * x[i]
-                    vn[i] = vb[i] + bv * x[i]
-                lift(qn, Qp, rows, sgn, Q)
-                lift(vn, zeroN, rows, sgn, Qd)
-                lift(x, zeroN, rows, sgn, Qdd)
-                residual(Q, Qd, Qdd, eidx, red, sg, nr, n, q_phi, q_psi, pow_p, pow_t, q_ds,
-                          q_w, q_pos, q_drows, bases, i_s1, rhoAs, Jrots, Ds, hf, grav,
-                          inertia, elasticity, gravity, cstep, r)
-                dnorm = 0.0
-                finite = True
-                for i in range(nr):
-                    s = 0.0
-                    for j in range(nr):
-                        s += Sinv[i, j] * r[j]
-                    dx[i] = s
-                    if not np.isfinite(s):
-                        finite = False
-                    w = newton_atol + 1e-15 * (abs(qb[i]) + abs(bq * x[i]))
-                    d = abs(bq * s) / w
-                    if d > dnorm:
-                        dnorm = d
-                if not finite:
-                    break
-                for i in range(nr):
-                    x[i] += dx[i]
-                if dnorm_old > 0.0:
-                    rate = dnorm / dnorm_old
-                    if rate >= 1.0 or rate ** (max_iter - k) / (1.0 - rate) * dnorm > 1.0:
-                        break
-                    eta = rate / (1.0 - rate)
-                if dnorm == 0.0 or eta * dnorm <= 1.0:
-                    ok = True
-                    break
-                dnorm_old = dnorm
-            if ok:
-                converged = True
+            converged, eta, iters, rate = _newton(
+                q, v, qdd, a, h, am, af, beta, gamma, newton_atol, max_iter, Sinv, eta, Qp,
+                rows, sgn, eidx, red, sg, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos,
+                q_drows, bases, i_s1, rhoAs, Jrots, Ds, hf, grav, inertia, elasticity,
+                gravity, cstep, x, qn, vn, an, stats)
+            if converged:
                 break
             stats[5] += 1
             if fresh:
@@ -240,14 +208,14 @@ def run_steps(q, v, qdd, a, n_steps, h, am, af, beta, gamma, newton_atol, max_it
             carry[1] = eta
             return NEWTON_FAILED, step
         for i in range(nr):
-            a[i] = ac[i] + c * (1.0 - af) * x[i]
-            q[i] = qb[i] + bq * x[i]
-            v[i] = vb[i] + bv * x[i]
+            a[i] = an[i]
+            q[i] = qn[i]
+            v[i] = vn[i]
             qdd_prev[i] = qdd[i]
             qdd[i] = x[i]
         fresh = False
         stats[0] += 1
-        if k >= 2 and rate > refresh_rate:
+        if iters >= 3 and rate > refresh_rate:
             have = False                           # slow contraction: new tangent next step
         if (step + 1) % record_every == 0:
             for i in range(nr):
@@ -258,3 +226,227 @@ def run_steps(q, v, qdd, a, n_steps, h, am, af, beta, gamma, newton_atol, max_it
     carry[0] = 1.0 if have else 0.0
     carry[1] = eta
     return OK, n_steps
+
+
+@_jit
+def _newton(q, v, qdd, a, h, am, af, beta, gamma, newton_atol, max_iter, Sinv, eta_in, Qp,
+            rows, sgn, eidx, red, sg, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_drows,
+            bases, i_s1, rhoAs, Jrots, Ds, hf, grav, inertia, elasticity, gravity, cstep,
+            x, qn, vn, an, stats):
+    """One generalized-α step of size h from (q, v, q̈, a) by Newton's iteration on q̈_{n+1}
+    from the starting iterate in x (the caller's predictor), with the inverse iteration matrix
+    Sinv and the RADAU5 stop test (module doc).  Writes q̈_{n+1} into x and (q, v, a)_{n+1}
+    into (qn, vn, an).  Returns (converged, eta, iterations, contraction rate)."""
+    nr = q.shape[0]
+    N = Qp.shape[0]
+    bq = beta * (1.0 - af) / (1.0 - am) * h * h
+    bv = gamma * (1.0 - af) / (1.0 - am) * h
+    c = 1.0 / (1.0 - am)
+    zeroN = np.zeros(N)
+    Q = np.empty(N)
+    Qd = np.empty(N)
+    Qdd = np.empty(N)
+    r = np.empty(nr)
+    dx = np.empty(nr)
+    qb = np.empty(nr)
+    vb = np.empty(nr)
+    ac = np.empty(nr)
+    for i in range(nr):
+        ac[i] = c * (af * qdd[i] - am * a[i])
+        qb[i] = q[i] + h * v[i] + h * h * ((0.5 - beta) * a[i] + beta * ac[i])
+        vb[i] = v[i] + h * ((1.0 - gamma) * a[i] + gamma * ac[i])
+    eta = max(eta_in, 2.2e-16) ** 0.8
+    dnorm_old = -1.0
+    rate = 0.0
+    for k in range(max_iter):
+        stats[2] += 1
+        stats[1] += 1
+        for i in range(nr):
+            qn[i] = qb[i] + bq * x[i]
+            vn[i] = vb[i] + bv * x[i]
+        lift(qn, Qp, rows, sgn, Q)
+        lift(vn, zeroN, rows, sgn, Qd)
+        lift(x, zeroN, rows, sgn, Qdd)
+        residual(Q, Qd, Qdd, eidx, red, sg, nr, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w,
+                 q_pos, q_drows, bases, i_s1, rhoAs, Jrots, Ds, hf, grav, inertia, elasticity,
+                 gravity, cstep, r)
+        dnorm = 0.0
+        for i in range(nr):
+            s = 0.0
+            for j in range(nr):
+                s += Sinv[i, j] * r[j]
+            dx[i] = s
+            if not np.isfinite(s):
+                return False, eta, k + 1, rate
+            w = newton_atol + 1e-15 * (abs(qb[i]) + abs(bq * x[i]))
+            d = abs(bq * s) / w
+            if d > dnorm:
+                dnorm = d
+        for i in range(nr):
+            x[i] += dx[i]
+        if dnorm_old > 0.0:
+            rate = dnorm / dnorm_old
+            if rate >= 1.0 or rate ** (max_iter - k) / (1.0 - rate) * dnorm > 1.0:
+                return False, eta, k + 1, rate
+            eta = rate / (1.0 - rate)
+        if dnorm == 0.0 or eta * dnorm <= 1.0:
+            for i in range(nr):
+                qn[i] = qb[i] + bq * x[i]
+                vn[i] = vb[i] + bv * x[i]
+                an[i] = ac[i] + c * (1.0 - af) * x[i]
+            return True, eta, k + 1, rate
+        dnorm_old = dnorm
+    return False, eta, max_iter, rate
+
+
+@_jit
+def run_adaptive(q, v, qdd, a, hs, t_out, k_out, max_steps, am, af, beta, gamma, c_err, rtol,
+                 atol, safety, fac_min, fac_max, h_min, h_max, t_end, newton_atol, max_iter,
+                 refresh_rate, rel_step, Qp, rows, sgn, eidx, red, sg, n, q_phi, q_psi, pow_p,
+                 pow_t, q_ds, q_w, q_pos, q_drows, bases, i_s1, rhoAs, Jrots, Ds, hf, grav,
+                 inertia, elasticity, gravity, cstep, no_acc, Y_out, stats, Mr, Kr, Cr, Sinv,
+                 carry):
+    """Error-controlled generalized-α steps (module doc) from hs[0] until t_end or
+    ``max_steps`` accepted steps, writing the Hermite-interpolated states (q, v) at the output
+    times t_out[k_out:] that the steps pass into Y_out's rows.
+
+    In place: (q, v, q̈, a) the state and auxiliary acceleration; hs (float) = [t, next h,
+    step that a belongs to (0: none), h of Sinv (0: none), smallest step, largest step (the
+    step landing on t_end not counted), error of the last accepted step (0: none; for
+    Gustafsson's predictive factor, as RADAU5 and the numpy reference)]; (Mr, Kr, Cr) the tangent and Sinv the inverse
+    iteration matrix; carry = [tangent valid (1/0), Newton's eta, last attempt rejected
+    (1/0)].  stats (int64): [steps, residuals, Newton iterations, tangents, inversions, failed
+    Newton attempts, rejected steps (error test or Newton), ...].  A Newton failure forms the
+    tangent at the current state and retries; with a fresh tangent it cuts h by 4.  Returns
+    (code, k_out): OK at t_end, PAUSED after max_steps steps, NEWTON_FAILED where the state is
+    not finite, STEP_TOO_SMALL where h would fall below h_min (hs[1] holds it)."""
+    nr = q.shape[0]
+    n_out = t_out.shape[0]
+    N = Qp.shape[0]
+    zeroN = np.zeros(N)
+    Q = np.empty(N)
+    Qd = np.empty(N)
+    Qdd = np.empty(N)
+    x = np.empty(nr)
+    qn = np.empty(nr)
+    vn = np.empty(nr)
+    an = np.empty(nr)
+    ash = np.empty(nr)
+    bqc = beta * (1.0 - af) / (1.0 - am)
+    bvc = gamma * (1.0 - af) / (1.0 - am)
+    done = 0
+    fresh = False
+    while hs[0] < t_end:
+        if done >= max_steps:
+            return PAUSED, k_out
+        t = hs[0]
+        h = hs[1]
+        last = t + h >= t_end
+        h_try = t_end - t if last else h
+        if carry[0] < 0.5:
+            lift(q, Qp, rows, sgn, Q)
+            lift(v, zeroN, rows, sgn, Qd)
+            lift(qdd, zeroN, rows, sgn, Qdd)
+            M_, K_, C_, F_ = mass_tangent(Q, Qd, Qdd, rel_step, eidx, red, sg, nr, n, q_phi,
+                                          q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_drows, bases,
+                                          i_s1, rhoAs, Jrots, Ds, hf, grav, inertia, elasticity,
+                                          gravity, cstep, no_acc)
+            Mr[:, :] = M_
+            Kr[:, :] = K_
+            Cr[:, :] = C_
+            stats[3] += 1
+            carry[0] = 1.0
+            hs[3] = 0.0
+            fresh = True
+        if h_try != hs[3]:
+            Sinv[:, :] = np.linalg.inv(Mr + (bqc * h_try * h_try) * Kr + (bvc * h_try) * Cr)
+            stats[4] += 1
+            hs[3] = h_try
+        # a_n belongs to the step hs[2]: moved to h_try by a_n ≈ q̈(t_n + Δα h) (reference)
+        ratio = 1.0 if hs[2] == 0.0 else h_try / hs[2]
+        for i in range(nr):
+            ash[i] = qdd[i] + ratio * (a[i] - qdd[i])
+            x[i] = qdd[i]                          # predictor: q̈_{n+1} = q̈_n
+        ok, eta, iters, rate = _newton(q, v, qdd, ash, h_try, am, af, beta, gamma, newton_atol,
+                                       max_iter, Sinv, carry[1], Qp, rows, sgn, eidx, red, sg,
+                                       n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, q_drows,
+                                       bases, i_s1, rhoAs, Jrots, Ds, hf, grav, inertia,
+                                       elasticity, gravity, cstep, x, qn, vn, an, stats)
+        carry[1] = eta
+        if not ok:
+            stats[5] += 1
+            if not fresh:
+                carry[0] = 0.0                  # a tangent at this state, same h
+                continue
+            stats[6] += 1
+            carry[2] = 1.0
+            hs[1] = 0.25 * h_try
+            if hs[1] < h_min:
+                return STEP_TOO_SMALL, k_out
+            continue
+        ssum = 0.0
+        finite = True
+        for i in range(nr):
+            w = atol + rtol * max(abs(q[i]), abs(qn[i]))
+            e = c_err * h_try * h_try * (x[i] - qdd[i]) / w
+            ssum += e * e
+            if not (np.isfinite(qn[i]) and np.isfinite(vn[i])):
+                finite = False
+        if not finite:
+            return NEWTON_FAILED, k_out
+        err = np.sqrt(ssum / nr)
+        if err > 1.0:
+            stats[6] += 1
+            carry[2] = 1.0
+            hs[1] = h_try * max(fac_min, min(1.0, safety * err ** (-1.0 / 3.0)))
+            if hs[1] < h_min:
+                return STEP_TOO_SMALL, k_out
+            continue
+        # accepted: outputs in (t, t + h_try] from the step's cubic Hermite interpolants
+        t_new = t_end if last else t + h_try
+        while k_out < n_out and t_out[k_out] <= t_new:
+            s = (t_out[k_out] - t) / h_try
+            if s >= 1.0:
+                for i in range(nr):
+                    Y_out[k_out, i] = qn[i]
+                    Y_out[k_out, nr + i] = vn[i]
+            else:
+                h00 = (2.0 * s - 3.0) * s * s + 1.0
+                h10 = ((s - 2.0) * s + 1.0) * s
+                h01 = (3.0 - 2.0 * s) * s * s
+                h11 = (s - 1.0) * s * s
+                for i in range(nr):
+                    Y_out[k_out, i] = (h00 * q[i] + h_try * h10 * v[i] + h01 * qn[i]
+                                       + h_try * h11 * vn[i])
+                    Y_out[k_out, nr + i] = (h00 * v[i] + h_try * h10 * qdd[i] + h01 * vn[i]
+                                            + h_try * h11 * x[i])
+            k_out += 1
+        for i in range(nr):
+            q[i] = qn[i]
+            v[i] = vn[i]
+            a[i] = an[i]
+            qdd[i] = x[i]
+        h_prev_acc = hs[2]
+        hs[0] = t_new
+        hs[2] = h_try
+        stats[0] += 1
+        done += 1
+        fresh = False
+        if not last:
+            hs[4] = min(hs[4], h_try)
+            hs[5] = max(hs[5], h_try)
+        if iters > 2 and rate > refresh_rate:
+            carry[0] = 0.0                      # slow contraction: a new tangent next step
+        # Gustafsson's predictive factor (RADAU5; the numpy reference's controller)
+        pred = 1.0
+        if hs[6] > 0.0 and err > 0.0 and h_prev_acc > 0.0:
+            pred = min(1.0, (h_try / h_prev_acc) * (hs[6] / err) ** (1.0 / 3.0))
+        hs[6] = max(err, 1e-10)
+        fac = fac_max if err == 0.0 else min(fac_max, safety * pred * err ** (-1.0 / 3.0))
+        if carry[2] > 0.5:
+            fac = min(fac, 1.0)                 # no growth right after a rejection
+        if 1.0 <= fac < 1.2:
+            fac = 1.0                           # keep h and the inverse (module doc)
+        hs[1] = min(h_max, h_try * max(fac_min, fac)) if not last else h
+        carry[2] = 0.0
+    return OK, k_out

@@ -196,9 +196,10 @@ def integrate(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
       state_jacobian`, ~1/6 of the cost at the paper's discretisation), or
       ``"finite_difference"``: scipy's differences of the whole right-hand side (one model.rhs
       per state per Jacobian);
-    * ``"generalized_alpha"``: the implicit second-order method at the fixed step
-      ``sol["h"]`` (:func:`integrate_alpha`) — for beam models without friction switching,
-      where the explicit step is stability-limited by the stiffest bending mode;
+    * ``"generalized_alpha"``: the implicit second-order method (:func:`integrate_alpha`),
+      error-controlled by rtol/atol, or at the fixed step ``sol["h"]`` where given — for beam
+      models without friction switching, where the explicit step is stability-limited by the
+      stiffest bending mode;
     * ``"auto"``: RK45 and BDF alternate as :class:`MethodSwitch` decides (RK45 -> BDF when
       :class:`StiffnessDetector` finds the step stability-limited, back to RK45 after a
       stretch whose length adapts to which method was cheaper); the statistics record the
@@ -378,17 +379,28 @@ class StructuredTangent:
 def integrate_alpha(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
     """Generalized-alpha (Chung & Hulbert 1993; Arnold & Bruels 2007) from y0 = (z0, z_dot0)
     at t = 0 with outputs at ``sol["n_output"]`` equally spaced times; the contract of
-    :func:`integrate`.  Solver keys: ``h`` (s, the largest step; each output interval is cut
-    into equal steps of at most h), ``rho_inf`` (spectral radius at infinity, [0, 1]) and
-    ``newton_atol`` (m, the position error the Newton iteration may leave per step).
+    :func:`integrate`.  Solver keys: ``rho_inf`` (spectral radius at infinity, [0, 1]),
+    ``newton_atol`` (m, the position error the Newton iteration may leave per step) and
 
-    Where :meth:`sim_core.model.model.Model.element_loop_plan` covers the model, the steps of
-    each output interval run in one compiled call
-    (:func:`sim_core.integrate._generalized_alpha_numba.run_steps`) with the tangent formed once
-    and reused across steps; otherwise the numpy method
-    (:func:`integrate_generalized_alpha`) with the structured tangent, at the same fixed step.
-    The wall budget ``max_wall_s`` and the progress callback are served between output
-    intervals; a failed Newton iteration raises SimulationError with the outputs so far."""
+    * ``h`` given (s): the fixed-step method, each output interval cut into equal steps of at
+      most h (:func:`_alpha_fixed`);
+    * no ``h``: error-controlled steps (:func:`_alpha_adaptive`) from ``rtol``/``atol``, with
+      the optional largest step ``h_max`` (s).
+
+    Where :meth:`sim_core.model.model.Model.element_loop_plan` covers the model, the steps run
+    in compiled calls (:mod:`sim_core.integrate._generalized_alpha_numba`) with the tangent
+    formed once and reused across steps; otherwise the numpy method
+    (:func:`integrate_generalized_alpha`) with the structured tangent.  The wall budget
+    ``max_wall_s`` and the progress callback are served between compiled calls (or after
+    every numpy step); a failed Newton iteration, a step below its floor, a stall or the
+    budget raise SimulationError (StalledIntegration for a stall) with the outputs so far."""
+    if sol.get("h") is None:
+        return _alpha_adaptive(model, y0, t_end, sol, progress)
+    return _alpha_fixed(model, y0, t_end, sol, progress)
+
+
+def _alpha_fixed(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
+    """Generalized-alpha at the fixed step ``sol["h"]`` (:func:`integrate_alpha`)."""
     n = model.n_dof
     t_eval = np.linspace(0.0, t_end, sol["n_output"])
     h, rho = float(sol["h"]), float(sol.get("rho_inf", 0.9))
@@ -460,6 +472,220 @@ def integrate_alpha(model, y0: np.ndarray, t_end: float, sol: dict, progress=Non
             raise fail(float(t_eval[k]), f"wall-clock budget solver.max_wall_s = {budget:g} s "
                        "exhausted", hh)
     return t_eval, np.array(ys), stats()
+
+
+class _StepPace:
+    """The stall test of :class:`StallMonitor` for step loops that report between calls:
+    after each call with (accepted steps so far, t), the mean step over the last ``window``
+    or more accepted steps below t_end / max_steps raises :class:`StalledIntegration`."""
+
+    def __init__(self, t_end: float, window: int, max_steps: float):
+        self.t_end, self.window = float(t_end), int(window)
+        self.floor = self.t_end / float(max_steps)
+        self.marks = [(0, 0.0)]                    # (accepted steps, t) after each call
+        self.slowest = math.inf
+
+    def update(self, steps: int, t: float, step: float, state: np.ndarray) -> None:
+        self.marks.append((int(steps), float(t)))
+        back = [m for m in self.marks if m[0] <= steps - self.window]
+        if not back:
+            return
+        n0, t0 = back[-1]
+        self.marks = self.marks[self.marks.index(back[-1]):]
+        n, mean = steps - n0, (t - t0) / (steps - n0)
+        self.slowest = min(self.slowest, mean)
+        if mean < self.floor and t < self.t_end:
+            raise StalledIntegration(
+                t, f"integration stalled: the last {n} accepted steps averaged {mean:.3g} s "
+                f"(~{(self.t_end - t) / max(mean, 1e-300):.2g} more steps to t_end), below "
+                f"t_end / {self.t_end / self.floor:.0e} = {self.floor:.3g} s; (dynamics the "
+                "error-controlled generalized-alpha cannot follow at this tolerance: loosen "
+                "solver.rtol/atol, or give a fixed solver.h)", mean_step=mean, window=n,
+                step=step, last_state=state)
+
+
+# error control of generalized-alpha without a fixed h (_alpha_adaptive)
+ALPHA_SAFETY, ALPHA_FAC_MIN, ALPHA_FAC_MAX = 0.9, 0.2, 5.0
+ALPHA_FLOOR = 1e-12          # smallest step / t_end
+
+
+def _alpha_adaptive(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
+    """Error-controlled generalized-alpha (:func:`integrate_alpha` without ``h``).
+
+    The local error estimate is the position one of
+    :mod:`sim_core.integrate.generalized_alpha`, e_q = c_q h^2 (q_ddot_{n+1} - q_ddot_n),
+    c_q = beta + delta_alpha / 2 - 1/6: the Newmark estimator of Zienkiewicz & Xie (1991),
+    (beta - 1/6) h^2 delta q_ddot, with generalized-alpha's constant.  Its RMS over the
+    coordinates, weighted by atol + rtol max(|q_n|, |q_{n+1}|) (m; scipy's norm), accepts a
+    step at <= 1; h_new = h clip(0.9 err^(-1/3), 0.2, 5) times Gustafsson's predictive
+    factor (<= 1; the numpy reference's controller), no growth right after a rejection,
+    h kept for a proposed factor in [1, 1.2) (RADAU5: Hairer & Wanner, Solving ODEs II,
+    Sect. IV.8), at most ``h_max``.  The velocity estimate of the numpy reference is left out:
+    for modes the step leaves unresolved (their dissipation is rho_inf's job) it saturates at
+    ~h times their acceleration amplitude and, against an atol in m/s, forces steps that
+    resolve them (module doc of :mod:`sim_core.integrate.generalized_alpha`).
+
+    Compiled path: the tangent (M, K, C) is formed at the start, after a Newton failure and
+    where Newton contracts slowly, and kept apart from the inverse iteration matrix, so a new
+    h costs one n x n inverse (a few us at 16-34 DOF, against ~12-40 us a step), never a
+    tangent (~0.7 ms).  First step: the h at which e_q would reach the tolerance if the
+    accelerations changed by their own size, (c_q RMS(q_ddot_0 / w))^(-1/2), at most
+    t_end / 100 and h_max; the error test corrects it within a few rejections.  Outputs: the
+    step's cubic Hermite interpolants (q from q, v; v from v, q_ddot), O(h^3) like the step.
+
+    A step below 1e-12 t_end (``ALPHA_FLOOR``) raises SimulationError; a mean step below
+    t_end / ``stall_max_steps`` (1e6) over 1000 accepted steps raises StalledIntegration
+    (the rule of :class:`StallMonitor`); calls return every 1000 steps for the budget."""
+    n = model.n_dof
+    t_eval = np.linspace(0.0, t_end, sol["n_output"])
+    rho = float(sol.get("rho_inf", 0.9))
+    rtol, atol = float(sol["rtol"]), float(sol["atol"])
+    newton_atol = float(sol.get("newton_atol", 0.1 * atol))
+    h_max = min(float(sol.get("h_max", t_end)), t_end)
+    h_min = ALPHA_FLOOR * t_end
+    budget = sol.get("max_wall_s")
+    window = int(sol.get("stall_window") or StallMonitor.window)
+    pace = _StepPace(t_end, window, sol.get("stall_max_steps") or StallMonitor.max_steps)
+    wall0 = time.perf_counter()
+    p = GeneralizedAlphaParameters.from_rho_inf(rho)
+    plan = model.element_loop_plan() if isinstance(model, Model) else None
+    Y = np.empty((len(t_eval), 2 * n))
+    Y[0] = y0
+    k_out = 1
+    counts = np.zeros(8, dtype=np.int64)   # steps, residuals, Newton its, tangents, inverses,
+    #                                        failed Newton attempts, rejected steps
+    hs = np.array([0.0, 0.0, 0.0, 0.0, math.inf, 0.0, 0.0])
+    state = {"y": np.array(y0, dtype=float)}
+
+    def stats():
+        wall = time.perf_counter() - wall0
+        out = {"wall_time_s": wall, "n_steps": int(counts[0]), "n_rejected": int(counts[6]),
+               "n_rhs": int(counts[1]), "n_newton_iterations": int(counts[2]),
+               "n_jac": int(counts[3]), "n_lu": int(counts[4]),
+               "n_newton_failures": int(counts[5]),
+               "min_step_s": float(hs[4]) if math.isfinite(hs[4]) else float(hs[5]),
+               "max_step_s": float(hs[5]), "method": "generalized_alpha",
+               "step_control": "error", "rtol": rtol, "atol": atol, "rho_inf": rho,
+               "h_max": h_max, "newton_atol": newton_atol, "compiled": plan is not None,
+               "real_time_factor": float(hs[0]) / max(wall, 1e-12)}
+        if math.isfinite(pace.slowest):
+            out["min_window_mean_step_s"] = float(pace.slowest)
+        return out
+
+    def fail(reason, step, cls=SimulationError, **kw):
+        exc = cls(float(hs[0]), reason, step=step, last_state=state["y"], **kw)
+        exc.partial = (t_eval[:k_out], Y[:k_out].copy(), stats())
+        return exc
+
+    def check_budget():
+        if budget is not None and time.perf_counter() - wall0 > budget and hs[0] < t_end:
+            raise fail(f"wall-clock budget solver.max_wall_s = {budget:g} s exhausted (last "
+                       f"step {hs[2]:.3g} s)", float(hs[2]))
+
+    if plan is None:
+        return _alpha_adaptive_numpy(model, y0, t_end, sol, progress, t_eval, p, rtol, atol,
+                                     h_max, h_min, budget, window, wall0)
+
+    q, v = np.array(y0[:n], dtype=float), np.array(y0[n:], dtype=float)
+    M0, _, _, f0 = ga_numba.mass_tangent(*_lifted(plan, q, v, np.zeros(n)), REL_STEP, plan.eidx,
+                                         plan.red, plan.sg, n, *plan.kernel_args, ec.NO_ACC)
+    qdd = np.linalg.solve(M0, f0)              # z_ddot(0) = M^-1 f (constant constraints)
+    a = qdd.copy()                             # a_0 = z_ddot(0) (Arnold & Bruels 2007)
+    w0 = atol + rtol * np.abs(q)
+    acc = math.sqrt(float(np.mean((qdd / w0) ** 2)))
+    hs[1] = max(h_min, min(h_max, 0.01 * t_end,
+                           (p.error_constant * acc) ** -0.5 if acc > 0 else t_end))
+    Mr, Kr, Cr, Sinv = (np.empty((n, n)) for _ in range(4))
+    carry = np.array([0.0, 1.0, 0.0])
+    try:
+        while True:
+            code, k_out = ga_numba.run_adaptive(
+                q, v, qdd, a, hs, t_eval, k_out, window, p.alpha_m, p.alpha_f, p.beta, p.gamma,
+                p.error_constant, rtol, atol, ALPHA_SAFETY, ALPHA_FAC_MIN, ALPHA_FAC_MAX, h_min,
+                h_max, t_end, newton_atol, 8, 0.3, REL_STEP, plan.Qp, plan.rows, plan.sgn,
+                plan.eidx, plan.red, plan.sg, *plan.kernel_args, ec.NO_ACC, Y, counts, Mr, Kr,
+                Cr, Sinv, carry)
+            state["y"] = np.concatenate([q, v])
+            if code == ga_numba.NEWTON_FAILED:
+                raise fail("generalized-alpha: the state is not finite after a converged "
+                           "Newton iteration; tighten solver.rtol/atol", float(hs[1]))
+            if code == ga_numba.STEP_TOO_SMALL:
+                raise fail(f"generalized-alpha: the error-controlled step fell to "
+                           f"{hs[1]:.3g} s, below its floor {ALPHA_FLOOR:g} t_end = {h_min:.3g} s "
+                           f"(error test or Newton failures at this state; loosen "
+                           f"solver.rtol/atol = {rtol:g}/{atol:g})", float(hs[1]))
+            pace.update(int(counts[0]), float(hs[0]), float(hs[2]), state["y"])
+            if progress is not None:
+                progress(float(hs[0]), time.perf_counter() - wall0)
+            if code == ga_numba.OK:
+                break
+            check_budget()
+    except StalledIntegration as exc:
+        exc.partial = (t_eval[:k_out], Y[:k_out].copy(), stats())
+        raise
+    except KeyboardInterrupt:              # Ctrl-C keeps what was computed, like a budget
+        raise fail("interrupted by the user (KeyboardInterrupt)", float(hs[2])) from None
+    return t_eval, Y, stats()
+
+
+def _alpha_adaptive_numpy(model, y0, t_end, sol, progress, t_eval, p, rtol, atol, h_max,
+                          h_min, budget, window, wall0):
+    """The numpy path of :func:`_alpha_adaptive`: :func:`integrate_generalized_alpha` with the
+    structured tangent, the position estimate and the same floor; the stall monitor, the
+    budget and the progress callback after every accepted step."""
+    n = model.n_dof
+    stall = StallMonitor(t_end, window, sol.get("stall_max_steps"), budget, wall0)
+    shim = type("Step", (), {})()
+    shim.t = shim.t_old = 0.0
+
+    def each_step(t, h, q, v):
+        shim.t_old, shim.t, shim.y = shim.t, t, np.concatenate([q, v])
+        if t < t_end:
+            stall.update(shim)
+            if budget is not None and time.perf_counter() - wall0 > budget:
+                raise SimulationError(t, f"wall-clock budget solver.max_wall_s = {budget:g} s "
+                                      f"exhausted (last step {h:.3g} s)", step=h,
+                                      last_state=shim.y)
+        if progress is not None:
+            progress(t, time.perf_counter() - wall0)
+
+    def stats(st):
+        wall = time.perf_counter() - wall0
+        out = {"wall_time_s": wall, "n_steps": int(st.n_steps),
+               "n_rejected": int(st.n_rejected or 0), "n_rhs": int(st.n_force_evaluations),
+               "n_newton_iterations": int(st.n_newton_iterations),
+               "n_jac": int(st.n_jacobian_evaluations), "n_lu": int(st.n_lu),
+               "n_newton_failures": int(st.n_newton_failures or 0),
+               "min_step_s": float(st.min_step) if st.n_steps else 0.0,
+               "max_step_s": float(st.max_step) if st.n_steps else 0.0,
+               "method": "generalized_alpha", "step_control": "error", "rtol": rtol,
+               "atol": atol, "rho_inf": p.rho_inf, "h_max": h_max,
+               "newton_atol": float(sol.get("newton_atol", 0.1 * atol)), "compiled": False,
+               "real_time_factor": float(shim.t) / max(wall, 1e-12)}
+        if math.isfinite(stall.slowest):
+            out["min_window_mean_step_s"] = float(stall.slowest)
+        return out
+
+    try:
+        r = integrate_generalized_alpha(
+            StructuredTangent(model), (0.0, t_end), y0[:n], y0[n:], rho_inf=p.rho_inf,
+            rtol=rtol, atol=atol, t_eval=t_eval, h_min=h_min, h_max=h_max,
+            max_steps=2 ** 62, safety=ALPHA_SAFETY, fac_min=ALPHA_FAC_MIN,
+            fac_max=ALPHA_FAC_MAX, error_estimate="position", callback=each_step)
+    except (SimulationError, KeyboardInterrupt) as exc:
+        ts, q, v, _ = getattr(exc, "partial_output", (t_eval[:1], y0[None, :n], y0[None, n:], None))
+        st = getattr(exc, "partial_stats", None)
+        if isinstance(exc, KeyboardInterrupt):  # Ctrl-C keeps what was computed, like a budget
+            err = SimulationError(shim.t, "interrupted by the user (KeyboardInterrupt)",
+                                  last_state=getattr(shim, "y", y0))
+        else:
+            err = exc
+        err.partial = (np.asarray(ts), np.hstack([q, v]),
+                       stats(st) if st is not None else {"method": "generalized_alpha"})
+        if err is exc:
+            raise
+        raise err from None
+    return t_eval, np.hstack([r.q, r.v]), stats(r.stats)
 
 
 def _lifted(plan, z, zd, zdd):

@@ -114,29 +114,31 @@ def choice(table: dict, key: str, where: str, allowed: tuple[str, ...], default=
 # -- the solver table (all scene kinds) ----------------------------------------------------------
 
 _SOLVER = {"t_end", "method", "jacobian", "rtol", "atol", "n_output", "max_step", "max_wall_s",
-           "h", "rho_inf", "newton_atol"}
+           "h", "h_max", "rho_inf", "newton_atol"}
 SOLVER_METHODS = ("RK45", "BDF", "auto", "generalized_alpha")
 JACOBIANS = ("structured", "finite_difference")
-_ALPHA_KEYS = ("h", "rho_inf", "newton_atol")
+_ALPHA_KEYS = ("h", "h_max", "rho_inf", "newton_atol")
 # the methods with error control, the stiffness switch and the stall monitor: the only ones for
 # systems whose forces switch (friction stick-slip, contact) or that hold nonlinear constraints
 ERROR_CONTROLLED = ("RK45", "BDF", "auto")
 
 
 def solver_table(s: dict, t_end=None, atol: float = 1e-8, n_output: int = 201,
-                 methods: tuple[str, ...] = SOLVER_METHODS) -> dict:
+                 methods: tuple[str, ...] = SOLVER_METHODS, method: str = "RK45") -> dict:
     """The validated [solver] table shared by every scene kind: t_end s (> 0), method
-    (``methods``, see :func:`sim_core.integrate.driver.integrate`), jacobian of the implicit
-    method (``JACOBIANS``: "structured" = :mod:`sim_core.model.state_jacobian`, "finite_difference" =
-    scipy's differences of the whole right-hand side), rtol (0, 1), atol (> 0),
-    n_output (>= 2), optional max_step s (> 0) and max_wall_s s (> 0, wall-clock budget).
-    With method "generalized_alpha": h s (> 0, required: the largest fixed step), rho_inf
-    (spectral radius at infinity, [0, 1], default 0.9) and newton_atol m (> 0, default 1e-8:
-    the position error the Newton iteration may leave per step).
+    (``methods``, default ``method``, see :func:`sim_core.integrate.driver.integrate`), jacobian
+    of the implicit method (``JACOBIANS``: "structured" = :mod:`sim_core.model.state_jacobian`,
+    "finite_difference" = scipy's differences of the whole right-hand side), rtol (0, 1), atol
+    (> 0), n_output (>= 2), optional max_step s (> 0) and max_wall_s s (> 0, wall-clock budget).
+    With method "generalized_alpha": rho_inf (spectral radius at infinity, [0, 1], default
+    0.9), and either h s (> 0, optional: a fixed step of at most h; rtol/atol then unused) or,
+    without h, error-controlled steps from rtol/atol with an optional largest step h_max s
+    (> 0); newton_atol m (> 0, the position error the Newton iteration may leave per step;
+    default 1e-8 with h, atol / 10 without, below the error the step control allows).
     The arguments are the scene kind's defaults (t_end None: required)."""
     check_keys(s, _SOLVER, "solver")
     out = {"t_end": number(s, "t_end", "solver", t_end, lo=0.0, lo_open=True),
-           "method": choice(s, "method", "solver", methods, "RK45"),
+           "method": choice(s, "method", "solver", methods, method),
            "jacobian": choice(s, "jacobian", "solver", JACOBIANS, "structured"),
            "rtol": number(s, "rtol", "solver", 1e-6, lo=0.0, hi=1.0, lo_open=True, hi_open=True),
            "atol": number(s, "atol", "solver", atol, lo=0.0, lo_open=True),
@@ -145,9 +147,19 @@ def solver_table(s: dict, t_end=None, atol: float = 1e-8, n_output: int = 201,
         if key in s:
             out[key] = number(s, key, "solver", lo=0.0, lo_open=True)
     if out["method"] == "generalized_alpha":
-        out["h"] = number(s, "h", "solver", lo=0.0, hi=out["t_end"], lo_open=True)
+        if "h" in s:
+            out["h"] = number(s, "h", "solver", lo=0.0, hi=out["t_end"], lo_open=True)
+            if "h_max" in s:
+                raise SceneError(f"solver.h_max = {s['h_max']!r}: only the error-controlled "
+                                 f"steps (no solver.h) have an h_max; solver.h = {s['h']!r} "
+                                 "fixes the step (remove one of them)")
+        else:
+            out["h_max"] = number(s, "h_max", "solver", out["t_end"], lo=0.0, hi=out["t_end"],
+                                  lo_open=True)
         out["rho_inf"] = number(s, "rho_inf", "solver", 0.9, lo=0.0, hi=1.0)
-        out["newton_atol"] = number(s, "newton_atol", "solver", 1e-8, lo=0.0, lo_open=True)
+        out["newton_atol"] = number(s, "newton_atol", "solver",
+                                    1e-8 if "h" in out else 0.1 * out["atol"], lo=0.0,
+                                    lo_open=True)
     else:
         for key in _ALPHA_KEYS:
             if key in s:

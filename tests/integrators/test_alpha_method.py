@@ -63,10 +63,18 @@ def test_compiled_loop_equals_the_numpy_method():
 
 
 def test_scene_rules():
-    with pytest.raises(SceneError, match=r"solver\.h: missing"):
-        sim_core.load_scene("beam_through_sleeve", {"solver.method": "generalized_alpha"})
+    """Beam scenes default to generalized-alpha, error-controlled (no h) with h_max = t_end and
+    newton_atol = atol / 10; h fixes the step and excludes h_max; the alpha keys belong to
+    generalized_alpha; telescopic scenes keep the error-controlled ODE methods."""
+    sol = sim_core.load_scene("beam_through_sleeve")["solver"]
+    assert sol["method"] == "generalized_alpha" and "h" not in sol
+    assert sol["h_max"] == sol["t_end"] and sol["newton_atol"] == pytest.approx(0.1 * sol["atol"])
+    with pytest.raises(SceneError, match=r"solver\.h_max .*only the error-controlled"):
+        sim_core.load_scene("cantilever_release", {"solver.h_max": 1e-3})
+    with pytest.raises(SceneError, match=r"solver\.h_max = -1.0: out of range"):
+        sim_core.load_scene("beam_through_sleeve", {"solver.h_max": -1.0})
     with pytest.raises(SceneError, match=r"solver\.rho_inf .*only method = 'generalized_alpha'"):
-        sim_core.load_scene("beam_through_sleeve", {"solver.rho_inf": 0.5})
+        sim_core.load_scene("beam_through_sleeve", {"solver.method": "RK45", "solver.rho_inf": 0.5})
     with pytest.raises(SceneError, match=r"solver\.method = 'generalized_alpha'"):
         sim_core.load_scene("telescopic_extraction", {"solver.method": "generalized_alpha"})
 

@@ -8,9 +8,11 @@ from sim_core.model.model import Model
 
 
 def _short_sleeve_scene() -> dict:
-    """0.01 s of the sleeve scene, 11 outputs, 4 sub-elements, unfiltered, from rest."""
+    """0.01 s of the sleeve scene, 11 outputs, 4 sub-elements, unfiltered, from rest, on RK45
+    (the right-hand-side failures below are the explicit method's)."""
     return load_scene("beam_through_sleeve", overrides={
-        "solver.t_end": 0.01, "solver.n_output": 11, "effects.filtering": False,
+        "solver.method": "RK45", "solver.t_end": 0.01, "solver.n_output": 11,
+        "effects.filtering": False,
         "beams.0.n_nodes": 5, "initial.static_equilibrium": False})
 
 
@@ -73,7 +75,8 @@ def test_wall_clock_budget_stops_with_a_partial_result(monkeypatch, tmp_path):
         return original(self, t, y)
 
     monkeypatch.setattr(Model, "rhs", slow_rhs)
-    over = {"solver.t_end": 0.01, "solver.n_output": 11, "effects.filtering": False,
+    over = {"solver.method": "RK45", "solver.t_end": 0.01, "solver.n_output": 11,
+            "effects.filtering": False,
             "beams.0.n_nodes": 5, "initial.static_equilibrium": False,
             "solver.max_wall_s": 0.05}
     with pytest.raises(SimulationError) as info:
