@@ -40,29 +40,71 @@ from typing import Callable
 
 import numpy as np
 
+from sim_core.physics import _rigid_body_numba as frame_compiled
+from sim_core.physics.beam import _moving_node_beam_numba as point_compiled
 from sim_core.physics.complex_step import COMPLEX_STEP
 from sim_core.physics.constraints import NonlinearConstraint
 
+# beam section frames from the compiled point kernel; False: the element's numpy evaluate (the
+# reference of tests/folding/test_rigid_body_paths.py)
+COMPILED_BEAM_FRAMES = True
+# planar body and turntable frames by the compiled loop (sim_core.physics._rigid_body_numba);
+# False: the numpy code below (the reference)
+COMPILED_PLANAR_FRAMES = True
 
-def _memo(fun):
-    """One evaluation per state (real and complex-step state kept)."""
-    memo: list = []
+
+def _memo(fun, cols):
+    """One evaluation per state of the coordinates ``cols`` the frame depends on (a state that
+    differs elsewhere, e.g. another body's coordinate perturbed for a Jacobian column, reuses
+    it).  The last real and the last complex-step evaluation are kept; a real state equal to
+    the real part of the last complex one is served from its real parts (equal to the real
+    evaluation to O(h^2) = 1e-40 relative, as in
+    :func:`sim_core.physics.constraints.material_point`).  ``cols(Q)`` -> int array; the
+    function gets ``coords`` = ``cols`` (the structured Jacobian differences only those)."""
+    memo: dict = {}
 
     def f(Q):
-        for Qm, res in memo:
-            if Qm.dtype == Q.dtype and Qm.shape == Q.shape and np.array_equal(Qm, Q):
+        c = cols(Q)
+        v = Q[c]
+        key = (c.tobytes(), v.tobytes())
+        kind = Q.dtype.kind
+        hit = memo.get(kind)
+        if hit is not None and hit[0] == key:
+            return hit[1]
+        if kind != "c":
+            hit = memo.get("c")
+            if hit is not None and hit[2] == key:
+                res = tuple(np.ascontiguousarray(x.real) for x in hit[1])
+                memo[kind] = (key, res, None)
                 return res
         res = fun(Q)
-        memo[:] = [m for m in memo if m[0].dtype != Q.dtype][:1] + [(Q.copy(), res)]
+        memo[kind] = (key, res, (key[0], v.real.tobytes()) if kind == "c" else None)
         return res
+    f.coords = cols
     return f
 
 
-def _cross_cols(a: np.ndarray, W: np.ndarray) -> np.ndarray:
-    """Column-wise W_j x a for W (3, N) and a (3,): returns (3, N)."""
-    return np.stack([W[1] * a[2] - W[2] * a[1],
-                     W[2] * a[0] - W[0] * a[2],
-                     W[0] * a[1] - W[1] * a[0]])
+def point_coords(owner, points, Q):
+    """Union of the coordinates the point functions depend on at Q (None where one does not
+    say), kept on ``owner`` while the points return the same index arrays (they do while a
+    beam point stays in its element)."""
+    cs = [getattr(p, "coords", None) for p in points]
+    if any(c is None for c in cs):
+        return None
+    cs = [c(Q) for c in cs]
+    key = tuple(id(c) for c in cs)
+    hit = owner.__dict__.get("_coords_memo")
+    if hit is None or hit[0] != key:
+        hit = owner._coords_memo = (key, cs, np.unique(np.concatenate(cs)))   # cs keeps ids valid
+    return hit[2]
+
+
+def _add_local(terms, M, F) -> None:
+    """Add a local (idx, Me, Fe) to the full (M, F); idx holds each coordinate once."""
+    idx, Me, Fe = terms
+    F[idx] += Fe
+    if M is not None and Me is not None:
+        M[np.ix_(idx, idx)] += Me
 
 
 def _cross3(a, b):
@@ -80,54 +122,83 @@ def rot_axis(axis: np.ndarray, angle) -> np.ndarray:
 
 # -- frame functions ---------------------------------------------------------------------------
 
+def _slew_basis(slew_axis, plane_basis):
+    """Constants of S(phi) B0 = cos(phi) (B0 - a a^T B0) + sin(phi) [a]x B0 + a a^T B0 (the
+    Rodrigues formula of :func:`rot_axis` times B0; a the unit slew axis)."""
+    a = np.asarray(slew_axis, float) / np.linalg.norm(slew_axis)
+    B0 = np.asarray(plane_basis, float)
+    K = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]], float)
+    P0 = np.outer(a, a) @ B0
+    return a, B0 - P0, K @ B0, P0
+
+
+def _cross_axis(a, r):
+    """a x r for a constant real a (3,) and r (3,) real or complex."""
+    return np.array([a[1] * r[2] - a[2] * r[1], a[2] * r[0] - a[0] * r[2],
+                     a[0] * r[1] - a[1] * r[0]])
+
+
 def turntable_frame(n_coords: int, i_phi: int, slew_axis, plane_basis, point=(0.0, 0.0, 0.0)):
     """Frame of the turntable at a point given in plane coordinates (u, v, w) (m).
 
     R = S(phi) B0 (columns e_u, e_v, n); W has the single column phi = slew axis."""
-    ax = np.asarray(slew_axis, float)
-    B0 = np.asarray(plane_basis, float)
+    ax, C0, S0, P0 = _slew_basis(slew_axis, plane_basis)
     p = np.asarray(point, float)
+    cols = np.array([i_phi])
+    cols.flags.writeable = False
 
     def fun(Q):
+        if COMPILED_PLANAR_FRAMES and frame_compiled.AVAILABLE:
+            return frame_compiled.planar_frame(Q, n_coords, i_phi, -1, -1, -1, C0, S0, P0, ax, p)
         phi = Q[i_phi]
-        R = rot_axis(ax, phi) @ B0
+        R = np.cos(phi) * C0 + np.sin(phi) * S0 + P0
         r = R @ p
-        J = np.zeros((3, n_coords), dtype=np.result_type(phi, float))
-        W = np.zeros((3, n_coords))
-        J[:, i_phi] = _cross3(ax, r)
+        J = np.zeros((3, n_coords), dtype=R.dtype)
+        W = np.zeros((3, n_coords), dtype=R.dtype)
+        J[:, i_phi] = _cross_axis(ax, r)
         W[:, i_phi] = ax
-        return r, J, R, W.astype(J.dtype)
-    return _memo(fun)
+        return r, J, R, W
+    return _memo(fun, lambda Q: cols)
 
 
 def planar_body_frame(n_coords: int, i_phi: int, i_body: int, slew_axis, plane_basis,
-                      point=(0.0, 0.0, 0.0)):
+                      point=(0.0, 0.0, 0.0), i_theta: int | None = None):
     """Frame of a rigid body with plane coordinates Q[i_body:i_body+3] = (u, v, theta) at the
-    body-frame point ``point`` (m).  See the module docstring for the kinematics."""
-    ax = np.asarray(slew_axis, float)
-    B0 = np.asarray(plane_basis, float)
+    body-frame point ``point`` (m); with ``i_theta`` the angle is Q[i_theta] instead (a body
+    that shares another's angle: the rod of a prismatic joint), the body then has only the
+    coordinates (u, v) = Q[i_body:i_body+2].  See the module docstring for the kinematics:
+    r = S B0 [(u, v, 0) + Rz p], J_u, J_v = columns e_u, e_v of S B0, J_theta = S B0 dRz/dtheta p,
+    J_phi = a x r; R = S B0 Rz; W_phi = a, W_theta = n = S B0 e3."""
+    ax, C0, S0, P0 = _slew_basis(slew_axis, plane_basis)
     p = np.asarray(point, float)
-    iu, iv, it = i_body, i_body + 1, i_body + 2
+    iu, iv, it = i_body, i_body + 1, i_body + 2 if i_theta is None else int(i_theta)
+    cols = np.array([i_phi, iu, iv, it])
+    cols.flags.writeable = False
 
     def fun(Q):
+        if COMPILED_PLANAR_FRAMES and frame_compiled.AVAILABLE:
+            return frame_compiled.planar_frame(Q, n_coords, i_phi, iu, iv, it, C0, S0, P0, ax, p)
         phi, th = Q[i_phi], Q[it]
-        S = rot_axis(ax, phi) @ B0
+        S = np.cos(phi) * C0 + np.sin(phi) * S0 + P0
         c, s = np.cos(th), np.sin(th)
-        Rz = np.array([[c, -s, 0 * c], [s, c, 0 * c], [0 * c, 0 * c, 1 + 0 * c]])
-        dRz = np.array([[-s, -c, 0 * c], [c, -s, 0 * c], [0 * c, 0 * c, 0 * c]])
-        loc = np.array([Q[iu], Q[iv], 0 * Q[iu]]) + Rz @ p
-        r = S @ loc
+        e_u, e_v, n = S[:, 0], S[:, 1], S[:, 2]
+        # Rz p = (c p0 - s p1, s p0 + c p1, p2), dRz/dtheta p = (-s p0 - c p1, c p0 - s p1, 0)
+        r = (Q[iu] + c * p[0] - s * p[1]) * e_u + (Q[iv] + s * p[0] + c * p[1]) * e_v + p[2] * n
         dt = np.result_type(Q, float)
         J = np.zeros((3, n_coords), dtype=dt)
         W = np.zeros((3, n_coords), dtype=dt)
-        J[:, iu] = S[:, 0]
-        J[:, iv] = S[:, 1]
-        J[:, it] = S @ (dRz @ p)
-        J[:, i_phi] = _cross3(ax, r)
+        J[:, iu] = e_u
+        J[:, iv] = e_v
+        J[:, it] = (-s * p[0] - c * p[1]) * e_u + (c * p[0] - s * p[1]) * e_v
+        J[:, i_phi] = _cross_axis(ax, r)
         W[:, i_phi] = ax
-        W[:, it] = S[:, 2]
-        return r, J, S @ Rz, W
-    return _memo(fun)
+        W[:, it] = n
+        R = np.empty((3, 3), dtype=dt)
+        R[:, 0] = c * e_u + s * e_v
+        R[:, 1] = c * e_v - s * e_u
+        R[:, 2] = n
+        return r, J, R, W
+    return _memo(fun, lambda Q: cols)
 
 
 def beam_frame(model, ibeam: int, s: float, point_global_offset=None, frame0=None):
@@ -137,7 +208,10 @@ def beam_frame(model, ibeam: int, s: float, point_global_offset=None, frame0=Non
     rotation per dQ (as in :func:`sim_core.physics.constraints.material_point`).  An optional rigid
     offset is given as its *global* vector at the configuration ``frame0`` (the section
     rotation R0 there); it is stored in section components p = R0^T o and follows the section:
-    r_o = r + R p, J_o = J - [R p]x W.
+    r_o = r + R p, J_o = J - [R p]x W.  The section kinematics come from the compiled point
+    kernel (:func:`sim_core.physics.beam._moving_node_beam_numba.point_kinematics`) where
+    ``COMPILED_BEAM_FRAMES`` and numba are on, else from the element's numpy ``evaluate``
+    (the reference).
     """
     beam = model.beams[ibeam]
     off = int(model.offsets[ibeam])
@@ -145,25 +219,41 @@ def beam_frame(model, ibeam: int, s: float, point_global_offset=None, frame0=Non
     p = None
     if point_global_offset is not None:
         p = np.asarray(frame0, float).T @ np.asarray(point_global_offset, float)
+    where = [off + imap for imap in beam.index_map]
+    for idx in where:                   # shared by every call: read-only
+        idx.flags.writeable = False
+
+    def cols(Q):
+        return where[model.element_at(ibeam, Q.real, float(s))]
 
     def fun(Q):
         e = model.element_at(ibeam, Q.real, float(s))
-        idx = off + beam.index_map[e]
-        kin = beam.elements[e].evaluate(Q[idx], s=np.array([s]), strains=False)
-        J = np.zeros((3, N), dtype=kin.J_r.dtype)
-        Jp = np.zeros((3, N), dtype=kin.J_r.dtype)
-        J[:, idx] = kin.J_r[0]
-        Jp[:, idx] = kin.J_psi[0]
-        frame = kin.sec.frame[0]                       # rows e_t, e_b, e_s
-        W = frame[[2, 0, 1]].T @ (kin.sec.tmat[0] @ Jp)
+        idx = where[e]
+        el = beam.elements[e]
+        if COMPILED_BEAM_FRAMES and point_compiled.AVAILABLE:
+            r, _, J_r, J_psi, _, _, frame, tmat = point_compiled.point_kinematics(el, Q[idx], s)
+        else:
+            kin = el.evaluate(Q[idx], s=np.array([s]), strains=False)
+            r, J_r, J_psi = kin.r[0], kin.J_r[0], kin.J_psi[0]
+            frame, tmat = kin.sec.frame[0], kin.sec.tmat[0]     # frame: rows e_t, e_b, e_s
+        # W = [e_s e_t e_b] tmat J_psi on the element's columns (tmat: section components
+        # ordered (s, t, b) of the small rotation per d(alpha, beta, gamma))
+        Wl = (frame[2][:, None] * tmat[0] + frame[0][:, None] * tmat[1]
+              + frame[1][:, None] * tmat[2]) @ J_psi
         R = frame.T
-        r = kin.r[0]
         if p is not None:
             o = R @ p
-            J = J + _cross_cols(o, W)
+            # column-wise W_j x o = [[0, o2, -o1], [-o2, 0, o0], [o1, -o0, 0]] W_j
+            ox = np.array([[0.0 * o[0], o[2], -o[1]], [-o[2], 0.0 * o[0], o[0]],
+                           [o[1], -o[0], 0.0 * o[0]]])
+            J_r = J_r + ox @ Wl
             r = r + o
+        J = np.zeros((3, N), dtype=J_r.dtype)
+        W = np.zeros((3, N), dtype=J_r.dtype)
+        J[:, idx] = J_r
+        W[:, idx] = Wl
         return r, J, R, W
-    return _memo(fun)
+    return _memo(fun, cols)
 
 
 # -- rigid body inertia ------------------------------------------------------------------------
@@ -179,19 +269,36 @@ class RigidBody:
     gravity: np.ndarray | None = None
     name: str = "rigid_body"
 
-    def add(self, t, Q, Qd, M, F):
-        r, J, R, W = self.com(Q)
+    def coords(self, Q):
+        """Coordinates the body's mass and force depend on (its frame's)."""
+        return point_coords(self, (self.com,), Q)
+
+    def velocity_coords(self, Q):
+        """Coordinates whose rates enter the force (the frame's: the convective terms)."""
+        return self.coords(Q)
+
+    def local(self, t, Q, Qd, mass=True):
+        """(idx, Me (or None), Fe) on the coordinates ``idx`` of the body's frame (all where the
+        frame does not say): the terms of the class docstring restricted to the columns of J, W
+        that are not identically zero."""
+        # the complex-step state first: the real one is served from its real parts
         _, Jc, _, Wc = self.com(Q + 1j * COMPLEX_STEP * Qd)
-        acc = (Jc @ Qd).imag / COMPLEX_STEP                     # Jdot Qd
-        wdot = (Wc @ Qd).imag / COMPLEX_STEP                    # Wdot Qd
+        _, J, R, W = self.com(Q)
+        idx = self.coords(Q)
+        idx = np.arange(len(Q)) if idx is None else idx
+        J, W, qd = J[:, idx], W[:, idx], Qd[idx]
+        acc = (Jc[:, idx] @ qd).imag / COMPLEX_STEP             # Jdot Qd (m/s^2)
+        wdot = (Wc[:, idx] @ qd).imag / COMPLEX_STEP            # Wdot Qd (rad/s^2)
         Ig = R @ np.asarray(self.inertia, float) @ R.T
-        om = W @ Qd
-        if M is not None:
-            M += self.mass * (J.T @ J) + W.T @ Ig @ W
+        om = W @ qd
+        Me = self.mass * (J.T @ J) + W.T @ Ig @ W if mass else None
         f = -self.mass * acc
         if self.gravity is not None:
             f = f + self.mass * np.asarray(self.gravity, float)
-        F += J.T @ f - W.T @ (Ig @ wdot + _cross3(om, Ig @ om))
+        return idx, Me, J.T @ f - W.T @ (Ig @ wdot + _cross3(om, Ig @ om))
+
+    def add(self, t, Q, Qd, M, F):
+        _add_local(self.local(t, Q, Qd, M is not None), M, F)
 
     def momentum(self, Q, Qd, point=np.zeros(3)):
         """Linear momentum (kg m/s) and angular momentum about ``point`` (kg m^2/s)."""
@@ -208,6 +315,11 @@ class CoordinateInertia:
     index: int
     inertia: float
     name: str = "turntable"
+
+    def local(self, t, Q, Qd, mass=True):
+        """(idx, Me (or None), Fe) on the one coordinate; no force."""
+        return (np.array([self.index]), np.array([[float(self.inertia)]]) if mass else None,
+                np.zeros(1))
 
     def add(self, t, Q, Qd, M, F):
         if M is not None:
@@ -241,6 +353,14 @@ class SpringDamperActuator:
     profile: object | None = None
     name: str = "cylinder"
 
+    def coords(self, Q):
+        """Coordinates the force depends on (the two pins' frames')."""
+        return point_coords(self, (self.a, self.b), Q)
+
+    def velocity_coords(self, Q):
+        """Coordinates whose rates enter the force (the damper's pin-distance rate)."""
+        return self.coords(Q)
+
     def length(self, Q):
         ra, Ja, _, _ = self.a(Q)
         rb, Jb, _, _ = self.b(Q)
@@ -261,9 +381,15 @@ class SpringDamperActuator:
         s_ref, v = self.reference(t)
         return self.k * (s - s_ref) + self.c * (g @ Qd - v), s, g
 
-    def add(self, t, Q, Qd, M, F):
+    def local(self, t, Q, Qd, mass=True):
+        """(idx, None, Fe): the force -F ds/dQ on the pins' coordinates (all where unknown)."""
         f, _, g = self.tension(t, Q, Qd)
-        F -= f * g
+        idx = self.coords(Q)
+        idx = np.arange(len(Q)) if idx is None else idx
+        return idx, None, -f * g[idx]
+
+    def add(self, t, Q, Qd, M, F):
+        _add_local(self.local(t, Q, Qd, M is not None), M, F)
 
 
 # -- joints --------------------------------------------------------------------------------------
@@ -282,7 +408,7 @@ def planar_pin(name: str, fa, fb, plane_frame) -> NonlinearConstraint:
         # dE/dQ_j = W_j x E  ->  d/dQ_j (E_k . d) = (W_j x E_k) . d = W_j . (E_k x d)
         J = E.T @ (Ja - Jb) + np.stack([_cross3(E[:, k], d) @ W for k in range(2)])
         return g, J
-    return NonlinearConstraint(name, 2, evaluate)
+    return NonlinearConstraint(name, 2, evaluate, points=(fa, fb, plane_frame))
 
 
 def revolute_axis(name: str, fa, fb, c_a, p_b, q_b) -> NonlinearConstraint:
@@ -301,7 +427,7 @@ def revolute_axis(name: str, fa, fb, c_a, p_b, q_b) -> NonlinearConstraint:
             g.append(u @ n)
             J.append(_cross3(u, n) @ (Wb - Wa))
         return np.array(g), np.vstack(J)
-    return NonlinearConstraint(name, 2, evaluate)
+    return NonlinearConstraint(name, 2, evaluate, points=(fa, fb))
 
 
 def prismatic_offset(name: str, fa, fb, axis_normal_a) -> NonlinearConstraint:
@@ -315,4 +441,4 @@ def prismatic_offset(name: str, fa, fb, axis_normal_a) -> NonlinearConstraint:
         e = Ra @ m_a
         d = rb - ra
         return np.atleast_1d(d @ e), (e @ (Jb - Ja) + _cross3(e, d) @ Wa)[None, :]
-    return NonlinearConstraint(name, 1, evaluate)
+    return NonlinearConstraint(name, 1, evaluate, points=(fa, fb))

@@ -1,5 +1,6 @@
 """End-to-end: the shipped folding_boom scene through the CLI (tiny horizon, coarse mesh) and
-the full 45 s scenario (@slow, O(1 h) CPU -- not part of the default run)."""
+the full 45 s scenario (@slow, ~50 s CPU with the scene's BDF -- not part of the default run;
+benchmarks/results/folding_speed.md)."""
 
 import json
 
@@ -31,7 +32,7 @@ def test_cli_run_writes_result_and_figures(tmp_path):
 
 @pytest.mark.slow
 def test_full_scenario():
-    """Full 45 s run (8 sub-elements, h = 0.005 s).  Checks: prescribed slew reached exactly;
+    """Full 45 s run (8 sub-elements, h = 0.005 s, BDF).  Checks: prescribed slew reached exactly;
     constraint violation below the Baumgarte/integrator bound 1e-4 m (steps ~ 5e-3 s ->
     ~20 steps per 1/xi, times rtol 2L = 2.4e-5); final boom-2 tip height near the rigid value
     2 + 12 sin 60 deg + 12 = 24.4 m (gravity sag of the unfolded booms < 1.5 m: boom 1's static

@@ -160,13 +160,15 @@ def test_unknown_jacobian_is_rejected():
 
 
 def test_folding_jacobian_without_point_dependencies():
-    """The folding manipulator's rigid-body points and spring-damper cylinders do not say which
-    coordinates they depend on: those pieces are differenced in every coordinate (the general
-    path) - same check, on a random subset of columns."""
+    """The folding manipulator's constraint rows with their point dependencies removed: those
+    pieces are differenced in every coordinate (the general path) - same check, on a random
+    subset of columns."""
     from sim_core.systems.folding.build import FoldingParams, build_folding
     fs = build_folding(FoldingParams(n_nodes=3))
     m = fs.model
-    assert any(c.points is None for c in m.nonlinear)
+    for c in m.nonlinear:
+        c.points = None                  # coords(Q) -> None: every coordinate is differenced
+    assert all(c.coords(fs.Q0) is None for c in m.nonlinear)
     rng = np.random.default_rng(0)
     z, _ = m.reduced_state(0.0, fs.Q0, np.zeros_like(fs.Q0))
     y = np.concatenate([z + 1e-4 * rng.standard_normal(len(z)), 1e-2 * rng.standard_normal(len(z))])

@@ -30,7 +30,8 @@ Joints (second seed Section 2.1, Eq. 7; Baumgarte Eq. 8 with xi1 = xi2 = 10 1/s 
   * rigid - boom pins (cylinder 1 rod on boom 1, cylinder 2 barrel at C, link a at F, link b at
     G): 3 point rows (the planar rigid chain holds the boom point in the plane; the section
     rotation at these pins is left to the beam - spherical on the boom side);
-  * barrel - rod: prismatic = linear row theta_rod = theta_barrel + lateral row.
+  * barrel - rod: prismatic = the rod's frame reads the barrel's angle coordinate (the rod has
+    coordinates (u, v) only) + lateral row.
 Cylinders are spring-dampers on the pin distance s (SCENARIOS B, PD):
     F = k (s - s_ref) + c (s_dot - v(t)),  s_ref = s_ref(0) + int v dt,
 v(t) from Eq. 52 (:class:`sim_core.physics.drive_profiles.Eq52Profile`); s_ref(0) from the static
@@ -57,8 +58,14 @@ Departures from the PDs
     unscaled matrix is numerically singular here (cond ~ 1e19).
 
 Cost: with h = 0.005 s the filter bounds |lambda| <= ~2.45/h, so RK45 takes steps of
-1e-3 ... 6e-3 s, and the full 45 s scene is far beyond the default tests, which use 2
-sub-elements per boom and compressed stages (run times: docs/performance.md).
+1.6e-3 ... 6e-3 s (stability-limited); the scene runs BDF, whose steps (~8 ms) follow rtol, with
+the structured state Jacobian (:mod:`sim_core.model.state_jacobian`), which differences each
+constraint and rigid-body term only in the coordinates of its frames (their ``coords``).  Each
+linear row fixes one coordinate (a rod shares its barrel's angle coordinate instead of a row
+theta_rod = theta_barrel), so the reduction is a signed selection and the model assembles block by
+block and solves the saddle-point system by block elimination over the two booms.  The default
+tests use 2 sub-elements per boom and compressed stages (run times: docs/performance.md,
+benchmarks/results/folding_speed.md).
 """
 
 from __future__ import annotations
@@ -70,7 +77,11 @@ import numpy as np
 from sim_core.model.boundary import LinearConstraint, boundary_condition
 from sim_core.model.model import Model
 from sim_core.physics.beam.moving_node_beam import Beam, BeamSection
-from sim_core.physics.constraints import NonlinearConstraint, distance_driver, point_coincidence
+from sim_core.physics.constraints import (
+    NonlinearConstraint,
+    distance_driver,
+    point_coincidence,
+)
 from sim_core.physics.drive_profiles import Eq52Profile
 from sim_core.physics.effects import Effect, Elasticity, Gravity, Inertia, StressFilter
 from sim_core.physics.rigid_body import (
@@ -81,6 +92,7 @@ from sim_core.physics.rigid_body import (
     cylinder_inertia,
     planar_body_frame,
     planar_pin,
+    point_coords,
     prismatic_offset,
     revolute_axis,
     turntable_frame,
@@ -246,12 +258,22 @@ class BoomRest:
     width: float = 1e-3
     name: str = "boom_rest"
 
+    def coords(self, Q):
+        """Coordinates the contact force depends on (the two points' frames')."""
+        return point_coords(self, (self.a, self.b), Q)
+
+    def velocity_coords(self, Q):
+        """Coordinates whose rates enter the force (the damper's gap rate)."""
+        return self.coords(Q)
+
     def gap(self, Q):
         ra, Ja, Ra, Wa = self.a(Q)
         rb, Jb, _, _ = self.b(Q)
         nu = Ra @ self.nu_a
         d = rb - ra
-        return d @ nu, nu @ (Jb - Ja) + np.cross(nu, d) @ Wa
+        nxd = np.array([nu[1] * d[2] - nu[2] * d[1], nu[2] * d[0] - nu[0] * d[2],
+                        nu[0] * d[1] - nu[1] * d[0]])          # nu x d
+        return d @ nu, nu @ (Jb - Ja) + nxd @ Wa
 
     def force(self, Q, Qd):
         g, dg = self.gap(Q)
@@ -263,10 +285,16 @@ class BoomRest:
         f += self.c * max(-gd, 0.0) * min(pen / w, 1.0)
         return f, dg
 
-    def add(self, t, Q, Qd, M, F):
+    def local(self, t, Q, Qd, mass=True):
+        """(idx, None, Fe): the contact force f dg/dQ on the two points' coordinates."""
         f, dg = self.force(Q, Qd)
-        if f:
-            F += f * np.real(dg)
+        idx = self.coords(Q)
+        idx = np.arange(len(Q)) if idx is None else idx
+        return idx, None, f * np.real(dg[idx])
+
+    def add(self, t, Q, Qd, M, F):
+        idx, _, Fe = self.local(t, Q, Qd)
+        F[idx] += Fe
 
 
 # -- assembly --------------------------------------------------------------------------------------
@@ -294,9 +322,13 @@ def build_folding(p: FoldingParams) -> FoldingSystem:
     offsets = np.cumsum([0] + [b.n_coords for b in beams])[:-1]
     n_beam = int(sum(b.n_coords for b in beams))
     i_phi = n_beam
+    # plane coordinates (u, v, theta) of each body; a rod has (u, v) and shares its barrel's
+    # theta (the angle part of the prismatic joint), so every linear row fixes one coordinate
     names = ("barrel1", "rod1", "barrel2", "rod2", "link_a", "link_b")
-    bodies = {nm: n_beam + 1 + 3 * k for k, nm in enumerate(names)}
-    n_extra = 1 + 3 * len(names)
+    sizes = [2 if nm.startswith("rod") else 3 for nm in names]
+    bodies = dict(zip(names, (n_beam + 1 + np.cumsum([0] + sizes[:-1])).tolist()))
+    theta = {nm: bodies[nm.replace("rod", "barrel")] + 2 for nm in names}
+    n_extra = 1 + sum(sizes)
     g_vec = np.array([-p.gravity, 0.0, 0.0])
     effects: list[Effect] = [Inertia(), Elasticity()]
     if p.filter_h > 0:
@@ -313,11 +345,6 @@ def build_folding(p: FoldingParams) -> FoldingSystem:
         lin.append(LinearConstraint("slew", [{i_phi: 1.0}], lambda t: np.array([sp(t)[0]]),
                                     lambda t: np.array([sp(t)[1]]),
                                     lambda t: np.array([sp(t)[2]])))
-    zero = lambda t: np.zeros(1)
-    for cyl in ("1", "2"):   # prismatic joints: theta_rod = theta_barrel (linear)
-        lin.append(LinearConstraint(f"prismatic{cyl}_angle",
-                                    [{bodies["rod" + cyl] + 2: 1.0, bodies["barrel" + cyl] + 2: -1.0}],
-                                    zero, zero, zero))
     model = Model(beams, effects, [], lin, n_extra=n_extra, baumgarte=tuple(p.baumgarte))
     N = model.n_coords
 
@@ -333,7 +360,8 @@ def build_folding(p: FoldingParams) -> FoldingSystem:
 
     def place(name, origin, towards):
         d = towards - origin
-        Q0[bodies[name]:bodies[name] + 3] = (origin[0], origin[1], np.arctan2(d[1], d[0]))
+        Q0[bodies[name]:bodies[name] + 2] = origin
+        Q0[theta[name]] = np.arctan2(d[1], d[0])     # a rod's is its barrel's (same direction)
         return float(np.linalg.norm(d))
 
     place("barrel1", pts["base1"], pts["P1"])
@@ -344,7 +372,8 @@ def build_folding(p: FoldingParams) -> FoldingSystem:
     place("link_b", pts["E"], pts["G"])
 
     def body(name, point=(0.0, 0.0, 0.0)):
-        return planar_body_frame(N, i_phi, bodies[name], SLEW_AXIS, PLANE_BASIS, point)
+        return planar_body_frame(N, i_phi, bodies[name], SLEW_AXIS, PLANE_BASIS, point,
+                                 i_theta=theta[name])
 
     turn = lambda point=(0.0, 0.0, 0.0): turntable_frame(N, i_phi, SLEW_AXIS, PLANE_BASIS, point)
 
