@@ -142,6 +142,40 @@ def targets(cons: list[NonlinearConstraint], t: float):
     return out[0], out[1], out[2]
 
 
+class StateMemo:
+    """The last evaluation of a point function per number kind (real, complex), keyed by the
+    values of the coordinates it depends on.  A real state equal to the real part of the last
+    complex one is served from that evaluation's real parts (equal to the real evaluation to
+    O(h^2) = 1e-40 relative for the complex step h = 1e-20), so constraint rows that need both
+    evaluate a point once."""
+
+    def __init__(self):
+        self._memo: dict = {}
+
+    def lookup(self, Q, cols):
+        """(key, the stored result or None) for state Q with dependence on coordinates cols."""
+        key = (cols.tobytes(), Q[cols].tobytes())
+        kind = Q.dtype.kind
+        hit = self._memo.get(kind)
+        if hit is not None and hit[0] == key:
+            return key, hit[1]
+        if kind != "c":
+            hit = self._memo.get("c")
+            if hit is not None and hit[2] == key:
+                res = tuple(np.ascontiguousarray(x.real) for x in hit[1])
+                self._memo[kind] = (key, res, None)
+                return key, res
+        return key, None
+
+    def store(self, Q, cols, key, res):
+        """Keep res as the evaluation at Q (cols and key as given to and by :meth:`lookup`);
+        returns res."""
+        kind = Q.dtype.kind
+        real_key = (key[0], Q[cols].real.tobytes()) if kind == "c" else None
+        self._memo[kind] = (key, res, real_key)
+        return res
+
+
 def material_point(model, ibeam: int, s_fixed: float | None = None, s_index: int | None = None,
                    offset=None):
     """Function Q -> (r (3,), dr/dQ (3, N), psi (3,), dpsi/dQ (3, N)) of a point of a beam.
@@ -169,24 +203,13 @@ def material_point(model, ibeam: int, s_fixed: float | None = None, s_index: int
     # evaluation is the real evaluation (to O(h^2) = 1e-40 relative, far below round-off): a
     # real state equal to the real part of the last complex one is served from it, so the
     # constraint rows, which need both, evaluate the point once
-    memo: dict = {}
+    memo = StateMemo()
 
     def f(Q):
         e, idx, cols = locate(Q)
-        vals = Q[cols]
-        key = (cols.tobytes(), vals.tobytes())
-        kind = Q.dtype.kind
-        hit = memo.get(kind)
-        if hit is not None and hit[0] == key:
-            return hit[1]
-        if kind != "c":
-            hit = memo.get("c")
-            if hit is not None and hit[2] == key:
-                res = tuple(np.ascontiguousarray(x.real) for x in hit[1])
-                memo[kind] = (key, res)
-                return res
-        res = _evaluate(Q, e, idx)
-        memo[kind] = (key, res, (key[0], vals.real.tobytes()) if kind == "c" else None)
+        key, res = memo.lookup(Q, cols)
+        if res is None:
+            res = memo.store(Q, cols, key, _evaluate(Q, e, idx))
         return res
 
     def _evaluate(Q, e, idx):

@@ -43,7 +43,7 @@ import numpy as np
 from sim_core.physics import _rigid_body_numba as frame_compiled
 from sim_core.physics.beam import _moving_node_beam_numba as point_compiled
 from sim_core.physics.complex_step import COMPLEX_STEP
-from sim_core.physics.constraints import NonlinearConstraint
+from sim_core.physics.constraints import NonlinearConstraint, StateMemo
 
 # beam section frames from the compiled point kernel; False: the element's numpy evaluate (the
 # reference of tests/folding/test_rigid_body_paths.py)
@@ -61,24 +61,13 @@ def _memo(fun, cols):
     evaluation to O(h^2) = 1e-40 relative, as in
     :func:`sim_core.physics.constraints.material_point`).  ``cols(Q)`` -> int array; the
     function gets ``coords`` = ``cols`` (the structured Jacobian differences only those)."""
-    memo: dict = {}
+    memo = StateMemo()
 
     def f(Q):
         c = cols(Q)
-        v = Q[c]
-        key = (c.tobytes(), v.tobytes())
-        kind = Q.dtype.kind
-        hit = memo.get(kind)
-        if hit is not None and hit[0] == key:
-            return hit[1]
-        if kind != "c":
-            hit = memo.get("c")
-            if hit is not None and hit[2] == key:
-                res = tuple(np.ascontiguousarray(x.real) for x in hit[1])
-                memo[kind] = (key, res, None)
-                return res
-        res = fun(Q)
-        memo[kind] = (key, res, (key[0], v.real.tobytes()) if kind == "c" else None)
+        key, res = memo.lookup(Q, c)
+        if res is None:
+            res = memo.store(Q, c, key, fun(Q))
         return res
     f.coords = cols
     return f

@@ -13,6 +13,8 @@ from boom_env import TelescopicBoomEnv
 from sim_core.systems.telescopic.modal import (TABLE_BOOMS, allowed_ranges, data_path, load_raw,
                                                 tables_for)
 
+from .first_mode import first_mode_table_and_jacobian
+
 IDS = ["boom_env/TelescopicExtraction-v0", "boom_env/TelescopicRetraction-v0"]
 
 
@@ -139,40 +141,8 @@ def test_five_section_first_mode_matches_the_full_models_state_jacobian():
     (2 zeta_j omega_1 / omega_j)^2 <= 1e-4 with zeta_j <= 0.16 of the higher modes at
     omega_j >= 5 omega_1 -> omega within 1e-4; zeta within 1 % (a 1 % quantity: its coupling
     share, zeta_j / zeta_1 times that, 1e-2)."""
-    from dataclasses import replace
-
-    from sim_core.model.state_jacobian import state_jacobian
-    from sim_core.physics.constraints import constraint_terms
-    from sim_core.systems.telescopic.modal import (L_GRID, N_NODES, equilibrium_at,
-                                                    reference_rope_lengths, table_params)
     payload, angle, L_s = 10000.0, 60.0, 5.0
-    r = load_raw(n_booms=5)
-    ia = int(np.flatnonzero(np.isclose(r["angles"], angle))[0])
-    ip = int(np.flatnonzero(np.isclose(r["payloads"], payload))[0])
-    iL = int(np.flatnonzero(np.isclose(L_GRID, L_s))[0])
-    w_tab, z_tab = r["omega"][ia, ip, iL, 0], r["zeta"][ia, ip, iL, 0]
-    p = replace(table_params(5), payload=payload, luffing_angle_deg=angle, n_nodes=N_NODES,
-                friction=False)
-    ts, z, lam = equilibrium_at(p, L_s, reference_rope_lengths(p))
-    m = ts.model
-    n = len(z)
-    J = state_jacobian(m, 0.0, np.concatenate([z, np.zeros(n)]), central=True)
-    ev, V = np.linalg.eig(J)
-    Q, _ = m.full_state(0.0, z, np.zeros(n))
-    C = constraint_terms(m.nonlinear, 0.0, Q, np.zeros_like(Q))[1] @ m.P
-    _, Jt, _, _ = ts.tip(Q)
-    best = None
-    for k in np.flatnonzero(ev.imag > 1e-6):
-        dz = V[:n, k]
-        on_manifold = np.linalg.norm(C @ dz) <= 1e-6 * np.linalg.norm(C) * np.linalg.norm(dz)
-        tip = np.abs(Jt @ m.P @ dz)
-        in_plane = np.hypot(tip[0], tip[2]) > 10.0 * tip[1]
-        if on_manifold and in_plane and (best is None or abs(ev[k]) < abs(ev[best])):
-            best = k
-    assert best is not None
-    w, zeta = abs(ev[best]), -ev[best].real / abs(ev[best])
-    print(f"first in-plane mode: table {w_tab / 2 / np.pi:.5f} Hz zeta {z_tab:.5f}; state "
-          f"Jacobian {w / 2 / np.pi:.5f} Hz zeta {zeta:.5f}")
+    w_tab, z_tab, w, zeta = first_mode_table_and_jacobian(5, payload, angle, L_s)
     assert abs(w - w_tab) <= 1e-4 * w_tab
     assert abs(zeta - z_tab) <= 0.01 * z_tab
 

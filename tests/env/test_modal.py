@@ -11,6 +11,7 @@ import pytest
 
 from sim_core.systems.telescopic.modal import ModalROM, allowed_ranges, load_raw, tables_for
 
+from .first_mode import first_mode_table_and_jacobian
 from .full_window import N_OUT, T_END, WINDOW, params, run_full
 
 
@@ -289,39 +290,7 @@ def test_three_boom_first_mode_matches_the_full_models_state_jacobian(payload, a
     the two difference Jacobians.  zeta = -Re(lambda) / |lambda|: an error e |lambda| of Re
     lambda is an absolute error e of zeta, same budget (measured: omega 3e-8 .. 8e-8 relative,
     zeta 4e-8 absolute)."""
-    from dataclasses import replace
-
-    from sim_core.model.state_jacobian import state_jacobian
-    from sim_core.physics.constraints import constraint_terms
-    from sim_core.systems.telescopic.modal import (L_GRID, N_NODES, equilibrium_at,
-                                                    reference_rope_lengths, table_params)
-    r = load_raw()
-    ia = int(np.flatnonzero(np.isclose(r["angles"], angle))[0])
-    ip = int(np.flatnonzero(np.isclose(r["payloads"], payload))[0])
-    iL = int(np.flatnonzero(np.isclose(L_GRID, L_s))[0])
-    w_tab, z_tab = r["omega"][ia, ip, iL, 0], r["zeta"][ia, ip, iL, 0]
-    p = replace(table_params(3), payload=payload, luffing_angle_deg=angle, n_nodes=N_NODES,
-                friction=False)
-    ts, z, lam = equilibrium_at(p, L_s, reference_rope_lengths(p))
-    m = ts.model
-    n = len(z)
-    J = state_jacobian(m, 0.0, np.concatenate([z, np.zeros(n)]), central=True)
-    ev, V = np.linalg.eig(J)
-    Q, _ = m.full_state(0.0, z, np.zeros(n))
-    C = constraint_terms(m.nonlinear, 0.0, Q, np.zeros_like(Q))[1] @ m.P
-    _, Jt, _, _ = ts.tip(Q)
-    best = None
-    for k in np.flatnonzero(ev.imag > 1e-6):
-        dz = V[:n, k]
-        on_manifold = np.linalg.norm(C @ dz) <= 1e-6 * np.linalg.norm(C) * np.linalg.norm(dz)
-        tip = np.abs(Jt @ m.P @ dz)
-        in_plane = np.hypot(tip[0], tip[2]) > 10.0 * tip[1]
-        if on_manifold and in_plane and (best is None or abs(ev[k]) < abs(ev[best])):
-            best = k
-    assert best is not None
-    w, zeta = abs(ev[best]), -ev[best].real / abs(ev[best])
-    print(f"first in-plane mode: table {w_tab / 2 / np.pi:.6f} Hz zeta {z_tab:.6f}; state "
-          f"Jacobian {w / 2 / np.pi:.6f} Hz zeta {zeta:.6f}")
+    w_tab, z_tab, w, zeta = first_mode_table_and_jacobian(3, payload, angle, L_s)
     tol = 1e-6 + 1e-7 + 2e-8
     assert abs(w - w_tab) <= tol * w_tab
     assert abs(zeta - z_tab) <= tol
