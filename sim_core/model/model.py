@@ -804,11 +804,13 @@ class Model:
         z, zd = y[:n], y[n:]
         return np.concatenate([zd, self.accelerations(t, z, zd)])
 
-    def reactions(self, t: float, z: np.ndarray, zd: np.ndarray) -> np.ndarray:
-        """Constraint multipliers lambda (one per constraint row): A^T lambda = M Q_ddot - F."""
+    def reactions(self, t: float, z: np.ndarray, zd: np.ndarray, solved=None) -> np.ndarray:
+        """Constraint multipliers lambda (one per constraint row): A^T lambda = M Q_ddot - F.
+        ``solved``: (z_ddot, lambda) of :meth:`accelerations_and_multipliers` at the same
+        state, where the caller has them (saves that solve)."""
         Q, Qd = self.full_state(t, z, zd)
         M, F = self.mass_force(t, Q, Qd)
-        zdd, lam = self.accelerations_and_multipliers(t, z, zd)
+        zdd, lam = solved if solved is not None else self.accelerations_and_multipliers(t, z, zd)
         R = M @ self.lift(t, zdd, 2) - F
         if self.nonlinear:
             R = R - constraint_terms(self.nonlinear, t, Q, Qd)[1].T @ lam

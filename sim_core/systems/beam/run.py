@@ -159,11 +159,12 @@ def _beam_result(model, scene, ts, ys, stats, error) -> Result:
         z, zd = y[:n], y[n:]
         try:
             with np.errstate(over="raise", divide="raise", invalid="raise", under="ignore"):
-                zdd = model.accelerations(t, z, zd)
+                solved = model.accelerations_and_multipliers(t, z, zd)
+                zdd = solved[0]
                 r, v, a = model.point_motion(last, L, t, z, zd, zdd)
                 Q, Qd = model.full_state(t, z, zd)
                 en = model.energies(t, Q, Qd, g)
-                reac = model.reactions(t, z, zd)
+                reac = model.reactions(t, z, zd, solved)
             if not (np.all(np.isfinite(zdd)) and np.all(np.isfinite(reac))
                     and np.isfinite(en["T"] + en["U"] + en["V"])):
                 raise FloatingPointError("non-finite accelerations, reactions or energies")
