@@ -30,7 +30,8 @@ Evaluation protocol (identical for every controller)
   over the same window: the vibration alone.  It equals the residual RMS when the deflection
   reference is the model's own static tip (the modal ROM); with ``fidelity="paper"`` the
   env's reference (the tables' static tip change added to the full model's tip at reset)
-  is off by mm at full extension, and this metric is not affected by that offset.
+  can be off by a constant (~0.1 mm at full extension with the current tables), and this
+  metric is not affected by such an offset.
 * ``peak_tip_deflection_m``: max |d| over the episode.
 * ``peak_telescopic_force_N``: max |F| of the telescopic cylinder force, F = F_rigid + Gamma . q''
   (see :func:`telescopic_force`).

@@ -415,10 +415,10 @@ def main(argv=None) -> int:
     ap.add_argument("--action-repeat", type=int, default=1,
                     help="hold each policy action for K env steps (agents.wrappers.ActionRepeat; "
                          "control period K x 0.05 s; default 1)")
-    ap.add_argument("--obs-offset", type=float, default=None,
+    ap.add_argument("--obs-offset", type=float, default=0.0,
                     help="random constant offset (m) of the observed tip deflection per "
-                         "episode (agents.wrappers.DeflectionOffset; default 0.005 with "
-                         "--residual, else 0)")
+                         "episode, drawn from [-X, X] (agents.wrappers.DeflectionOffset; "
+                         "default 0: no offsets; the variant in agents/README.md uses 0.005)")
     ap.add_argument("--env-set", action="append", default=[], metavar="KEY=VALUE",
                     help="training-env constructor argument (replaces the defaults "
                          f"{TRAIN_ENV_KWARGS}); repeatable")
@@ -462,8 +462,7 @@ def main(argv=None) -> int:
                   action_repeat=args.action_repeat, residual=args.residual,
                   residual_scale=args.residual_scale, residual_omega=args.residual_omega,
                   residual_w_track=args.residual_track_weight,
-                  obs_offset=(args.obs_offset if args.obs_offset is not None
-                              else 0.005 if args.residual else 0.0),
+                  obs_offset=args.obs_offset,
                   hyperparams=load_hyperparams(args.hyperparams))
     if args.seeds is not None:
         if len(set(args.seeds)) != len(args.seeds):

@@ -209,11 +209,13 @@ class ResidualOnSchedule(gym.Wrapper):
 class DeflectionOffset(gym.ObservationWrapper):
     """Training aid for robustness: adds a constant offset, drawn per episode uniformly from
     [-max_offset, max_offset] m for each component, to the observed tip deflection (dX, dZ;
-    observation indices 5, 6).  The reward is the env's (true deflection).  Reason: on the full
-    model the env's deflection reference (the tables' static tip change added to the tip at
-    reset) is off by mm after the motion, which a policy trained on the modal ROM (offset 0)
-    answered by holding the stroke 2 cm short (agents/README.md); with random offsets the
-    policy cannot rely on the absolute deflection."""
+    observation indices 5, 6).  The reward is the env's (true deflection).  Purpose: a policy
+    trained with random offsets cannot rely on the absolute deflection, against a deflection
+    reference that is off on the model the policy runs on (on the full model the env's
+    reference is the tables' static tip change added to the tip at reset).  Off by default
+    (``agents.train_ppo --obs-offset``, default 0): with the current modal tables that
+    reference is within ~0.1 mm on the full model, and the residual policies trained without
+    offsets do better there than those trained with 5 mm offsets (agents/README.md)."""
 
     def __init__(self, env: gym.Env, max_offset: float = 5e-3):
         super().__init__(env)

@@ -203,18 +203,19 @@ def _deterministic_return(policy, obs_filter=lambda o: o) -> float:
 
 @pytest.mark.slow
 def test_rl_zoo_sac_with_the_shipped_settings_beats_standing_still(tmp_path):
-    """RL Zoo, SAC, the shipped sac.yml, 100k env steps, seed 0 (2.5-10 min on 2 cores), with
+    """RL Zoo, SAC, the shipped sac.yml, 100k env steps, seed 0 (2-10 min on 2 cores), with
     RL Zoo's evaluation every 10k steps (deterministic policy; one episode: env and start are
-    deterministic, so one episode is exact): the best evaluated policy, the one RL Zoo keeps as
-    best_model.zip, scores clearly better than standing still, and the final policy (re-run
-    here with the saved observation statistics) better than standing still.
+    deterministic, so one episode is exact).  Asserts: the best evaluated policy, the one RL
+    Zoo keeps as best_model.zip, scores clearly better than standing still, and the final
+    policy (re-run here with the saved observation statistics, equal to RL Zoo's evaluation at
+    100k) better than standing still.
     "Standing still" = the zero action, measured here (-11 per s unscaled over 30 s: -3.3).
     "Clearly": at least a quarter of the gap between standing still and the paper's cubic
-    schedule (-1.588, measured here) is closed.  The returns are exact, so any margin is real;
-    a quarter (0.43, 43 unscaled, ~4 s of standing still) asks for a policy that extends a
-    good part of the way.  Seeds 1 and 2 met it too (best -2.46 and -2.15 within 60k steps:
-    agents/README.md); the final policies fall back by up to ~1 from the best, hence the
-    weaker check on them."""
+    schedule (-1.588, measured here) is closed, i.e. a return above -2.87.  The returns are
+    exact, so any margin is real; a quarter (0.43, 43 unscaled, ~4 s of standing still) asks
+    for a policy that extends a good part of the way.  The check on the final policy is weaker
+    because SAC's evaluated returns swing from one evaluation to the next (agents/README.md,
+    "Standard learners on the registered env", gives the measured returns and the command)."""
     import pickle
 
     from stable_baselines3 import SAC
