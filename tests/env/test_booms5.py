@@ -1,10 +1,7 @@
-"""boom_env and the modal ROM with five sections (``booms=5``): the env checkers, the shipped
-five-section tables against the full model and against kinematics, the scene route, and the
-errors for boom counts without tables."""
+"""boom_env and the modal ROM with five sections (``booms=5``; the env checkers run in
+test_env.py for both boom counts): the shipped five-section tables against the full model and
+against kinematics, the scene route, and the errors for boom counts without tables."""
 
-import warnings
-
-import gymnasium as gym
 import numpy as np
 import pytest
 
@@ -14,28 +11,6 @@ from sim_core.systems.telescopic.modal import (TABLE_BOOMS, allowed_ranges, data
                                                 tables_for)
 
 from .first_mode import first_mode_table_and_jacobian
-
-IDS = ["boom_env/TelescopicExtraction-v0", "boom_env/TelescopicRetraction-v0"]
-
-
-@pytest.mark.parametrize("env_id", IDS)
-def test_gymnasium_check_env_five_booms(env_id):
-    from gymnasium.utils.env_checker import check_env
-    env = gym.make(env_id, booms=5)
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        check_env(env.unwrapped)
-    env.close()
-
-
-@pytest.mark.parametrize("env_id", IDS)
-def test_sb3_check_env_five_booms(env_id):
-    from stable_baselines3.common.env_checker import check_env
-    env = gym.make(env_id, booms=5)
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        check_env(env.unwrapped, warn=True)
-    env.close()
 
 
 @pytest.mark.parametrize("bad", [4, 2, 6, 0, True, "5", 5.5, None])

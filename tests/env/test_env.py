@@ -13,20 +13,22 @@ from boom_env import TelescopicBoomEnv
 IDS = ["boom_env/TelescopicExtraction-v0", "boom_env/TelescopicRetraction-v0"]
 
 
+@pytest.mark.parametrize("booms", [3, 5])
 @pytest.mark.parametrize("env_id", IDS)
-def test_gymnasium_check_env_no_warnings(env_id):
+def test_gymnasium_check_env_no_warnings(env_id, booms):
     from gymnasium.utils.env_checker import check_env
-    env = gym.make(env_id)
+    env = gym.make(env_id, booms=booms)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         check_env(env.unwrapped)
     env.close()
 
 
+@pytest.mark.parametrize("booms", [3, 5])
 @pytest.mark.parametrize("env_id", IDS)
-def test_sb3_check_env_no_warnings(env_id):
+def test_sb3_check_env_no_warnings(env_id, booms):
     from stable_baselines3.common.env_checker import check_env
-    env = gym.make(env_id)
+    env = gym.make(env_id, booms=booms)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         check_env(env.unwrapped, warn=True)
