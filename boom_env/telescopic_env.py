@@ -105,19 +105,19 @@ notes).
 
 With ``booms=5`` the deflection scales d_ref, dv_ref (and the success tolerances below) are
 10 times larger by default (1 cm, 0.1 m/s): the same stroke history deflects the
-five-section tip about 9 times as much (the paper's cubic schedule: peak 30.4 mm at 10 t
-against 3.4 mm for three booms at 25 t).  With the three-boom scales the schedule would score
+five-section tip about 8 times as much (the paper's cubic schedule: peak 30.4 mm at 10 t
+against 3.7 mm for three booms at 25 t).  With the three-boom scales the schedule would score
 -3549 unscaled, ten times worse than standing still (-330); with the scaled ones -144.4
-(extraction; retraction -69.4 and successful), like the -147.6 of three booms, and the
+(extraction; retraction -69.4 and successful), like the -158.8 of three booms, and the
 weights keep their meaning for both counts.  ``d_ref``, ``dv_ref`` (m, m/s) are constructor
 arguments (default None: the scale of the boom count).
 
 ``reward_scale`` multiplies every term and leaves their ratios, and so the ranking of any two
 policies, unchanged.  Unscaled (``reward_scale=1``) a 30 s episode of uniform random actions
 scores -5e3 to -3e4 (the quadratic vibration terms of a white-noise jerk), standing still
--330, the paper's cubic schedule -147.6; a learner with default settings (no reward
+-330, the paper's cubic schedule -158.8; a learner with default settings (no reward
 normalisation) fitted its value function to returns of that size (value loss ~2e6) and learned
-nothing useful.  The default 0.01 brings these to -50...-300, -3.3 and -1.476, the range
+nothing useful.  The default 0.01 brings these to -50...-300, -3.3 and -1.588, the range
 default hyper-parameters are made for.  ``info["reward_unscaled"]`` carries the step's reward
 before scaling.
 
@@ -192,7 +192,7 @@ BOOMS = tuple(TABLE_BOOMS)  # boom counts with modal tables: 3 (the paper's), 5
 DEFAULT_PAYLOAD = {3: 25000.0, 5: 10000.0}   # kg: the paper scene's; the 5-section scenes'
 # deflection scales of the reward and the success test for three booms (m, m/s); five booms
 # take 10 times them: the paper's cubic schedule deflects the five-section tip 30.4 mm at
-# 10 t against 3.4 mm for three booms at 25 t (ratio 9)
+# 10 t against 3.7 mm for three booms at 25 t (ratio 8)
 DEFLECTION_REFS = {"d_ref": 1e-3, "dv_ref": 1e-2, "tol_deflection": 2e-4,
                    "tol_deflection_rate": 2e-3}
 DEFLECTION_SCALE = {3: 1.0, 5: 10.0}

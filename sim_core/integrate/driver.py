@@ -446,10 +446,7 @@ def _alpha_fixed(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
         return t_eval, np.array(ys), stats()
 
     q, v = np.array(y0[:n], dtype=float), np.array(y0[n:], dtype=float)
-    M0, _, _, f0 = ga_numba.mass_tangent(*_lifted(plan, q, v, np.zeros(n)), REL_STEP, plan.eidx,
-                                         plan.red, plan.sg, n, *plan.kernel_args, ec.NO_ACC)
-    qdd = np.linalg.solve(M0, f0)              # z_ddot(0) = M^-1 f (constant constraints)
-    a = qdd.copy()                             # a_0 = z_ddot(0) (Arnold & Bruels 2007)
+    qdd, a = _initial_accelerations(plan, q, v)
     Sinv, qdd_prev, carry = np.empty((n, n)), qdd.copy(), np.array([0.0, 1.0])
     out = np.empty((2, n)), np.empty((2, n)), np.empty((2, n))
     for k in range(1, len(t_eval)):
@@ -587,10 +584,7 @@ def _alpha_adaptive(model, y0: np.ndarray, t_end: float, sol: dict, progress=Non
                                      h_max, h_min, budget, window, wall0)
 
     q, v = np.array(y0[:n], dtype=float), np.array(y0[n:], dtype=float)
-    M0, _, _, f0 = ga_numba.mass_tangent(*_lifted(plan, q, v, np.zeros(n)), REL_STEP, plan.eidx,
-                                         plan.red, plan.sg, n, *plan.kernel_args, ec.NO_ACC)
-    qdd = np.linalg.solve(M0, f0)              # z_ddot(0) = M^-1 f (constant constraints)
-    a = qdd.copy()                             # a_0 = z_ddot(0) (Arnold & Bruels 2007)
+    qdd, a = _initial_accelerations(plan, q, v)
     w0 = atol + rtol * np.abs(q)
     acc = math.sqrt(float(np.mean((qdd / w0) ** 2)))
     hs[1] = max(h_min, min(h_max, 0.01 * t_end,
@@ -686,6 +680,17 @@ def _alpha_adaptive_numpy(model, y0, t_end, sol, progress, t_eval, p, rtol, atol
             raise
         raise err from None
     return t_eval, np.hstack([r.q, r.v]), stats(r.stats)
+
+
+def _initial_accelerations(plan, q, v):
+    """(z_ddot(0), a_0) of the compiled generalized-alpha loops: z_ddot = M^-1 f at (q, v) with
+    the plan's constant selecting constraints, and the auxiliary acceleration a_0 = z_ddot(0)
+    (Arnold & Bruels 2007)."""
+    n = len(q)
+    M0, _, _, f0 = ga_numba.mass_tangent(*_lifted(plan, q, v, np.zeros(n)), REL_STEP, plan.eidx,
+                                         plan.red, plan.sg, n, *plan.kernel_args, ec.NO_ACC)
+    qdd = np.linalg.solve(M0, f0)
+    return qdd, qdd.copy()
 
 
 def _lifted(plan, z, zd, zdd):

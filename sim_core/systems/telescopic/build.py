@@ -111,8 +111,7 @@ def rope_static_tension(p: TelescopicParams, j: int) -> float:
     F.  Boom i+1 of a cylinder stage: F = W_(i+1) + 2 T_(i+2); boom i = j of a rope unit:
     T_j = W_j + F - T_(j+2) = W_j + W_(j+1) + T_(j+2), which sums from the tip to the formula
     (docs/model.md, "N-boom drives")."""
-    masses = [p.boom_length * p.sections[min(i, len(p.sections) - 1)][2]
-              for i in range(p.n_booms)]
+    masses = [p.boom_length * boom_section(i, p).rhoA for i in range(p.n_booms)]
     return (sum(masses[j:]) + p.payload) * p.gravity * math.sin(math.radians(p.luffing_angle_deg))
 
 

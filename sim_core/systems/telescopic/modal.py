@@ -107,6 +107,13 @@ def data_path(n_booms: int = 3) -> Path:
     return DATA if n_booms == 3 else DATA.with_name(f"modal_telescopic_{n_booms}.npz")
 
 
+def _require_synchronized(mechanism: str, hint: str = "") -> None:
+    """ValueError unless the drive is synchronized: the tables follow one stroke coordinate."""
+    if mechanism != "synchronized":
+        raise ValueError(f"mechanism = {mechanism!r}: the modal tables follow one stroke "
+                         f"coordinate (allowed: 'synchronized'){hint}")
+
+
 def table_params(n_booms: int = 3) -> TelescopicParams:
     """The TelescopicParams the tables of ``n_booms`` sections are built from (payload, angle,
     stroke and n_nodes set per configuration; frictionless, synchronized drive)."""
@@ -377,9 +384,7 @@ def build_tables(path=None, payloads=None, angles=ANGLES, L_grid=L_GRID, log=pri
     if base is None:
         base = table_params(n_booms)
     n_booms = base.n_booms
-    if base.mechanism != "synchronized":
-        raise ValueError(f"mechanism = {base.mechanism!r}: the modal tables follow one stroke "
-                         "coordinate (allowed: 'synchronized')")
+    _require_synchronized(base.mechanism)
     path = data_path(n_booms) if path is None else path
     payloads = TABLE_BOOMS.get(n_booms, PAYLOADS) if payloads is None else payloads
     t0 = time.perf_counter()
@@ -612,10 +617,7 @@ def check_params(p) -> None:
         raise ValueError(f"n_booms = {p.n_booms!r}: the modal tables are built for booms "
                          f"{', '.join(str(k) for k in TABLE_BOOMS)} (allowed values); use the "
                          "full model (model.reduction = 'none')")
-    if getattr(p, "mechanism", "synchronized") != "synchronized":
-        raise ValueError(f"mechanism = {p.mechanism!r}: the modal tables follow one stroke "
-                         "coordinate (allowed: 'synchronized'); use the full model "
-                         "(model.reduction = 'none')")
+    _require_synchronized(p.mechanism, "; use the full model (model.reduction = 'none')")
     ref = table_params(p.n_booms)
     for k in ("n_booms", "boom_length", "L_h", "E", "rho", "rope_EA", "gravity", "filter_h",
               "sections", "torsion", "rope_elasticity", "flexible"):
