@@ -72,13 +72,69 @@ def state_jacobian(model, t: float, y: np.ndarray, rel_step: float = REL_STEP,
     ``central``: central instead of forward differences (twice the work; truncation error
     O(h^2) instead of O(h), for checks).  With ``return_cost`` also the cost in whole
     right-hand-side evaluations."""
-    n, N = model.n_dof, model.n_coords
+    n = model.n_dof
     y = np.asarray(y, dtype=float)
     z, zd = y[:n], y[n:]
     zdd, lam = model.accelerations_and_multipliers(t, z, zd)
     Q, Qd = model.full_state(t, z, zd)
-    Q, Qd = Q.copy(), Qd.copy()
     Qdd = model.lift(t, zdd, 2)
+    dR1, dR2, G, cost = residual_derivatives(model, t, Q, Qd, Qdd, lam, rel_step, central)
+    N, m = model.n_coords, len(lam)
+
+    dF_dlam = np.zeros((N, m))
+    for mf in model.multiplier_forces:
+        if hasattr(mf, "at_state"):         # analytic: F_mu = E g(lambda), the friction Newton's
+            at = mf.at_state(t, Q, Qd)
+            np.add.at(dF_dlam, at.coords, at.values(lam, gradient=True)[1])
+            continue
+        lx = lam.copy()
+        dF_dlam += _difference(lambda mf=mf: mf.forces(t, Q, Qd, lx), lx, np.arange(m),
+                               rel_step, central)
+
+    # reduced coordinates and the saddle-point solve (X P and P^T X by Model._times_P: a signed
+    # selection where P only selects coordinates)
+    XP = model._times_P
+
+    def PtXP(X):
+        return XP(XP(X).T).T
+
+    Mr, _ = model.reduced_mass_force(t, z, zd)
+    if m:
+        if G is None:
+            G = constraint_terms(model.nonlinear, t, Q, Qd)[1]
+        C = XP(G)
+    else:
+        C = np.zeros((0, n))
+    A = np.zeros((n + m, n + m))
+    A[:n, :n] = -Mr
+    A[:n, n:] = C.T + XP(dF_dlam.T).T
+    A[n:, :n] = C
+    B = np.empty((n + m, 2 * n))
+    B[:n, :n] = PtXP(dR1[:, :N])
+    B[:n, n:] = PtXP(dR1[:, N:])
+    B[n:, :n] = XP(dR2[:, :N])
+    B[n:, n:] = XP(dR2[:, N:])
+    dU = -sla.solve(A, B)
+    jac = np.zeros((2 * n, 2 * n))
+    jac[:n, n:] = np.eye(n)
+    jac[n:] = dU[:n]
+    if return_cost:
+        return jac, cost
+    return jac
+
+
+def residual_derivatives(model, t: float, Q: np.ndarray, Qd: np.ndarray, Qdd: np.ndarray,
+                         lam: np.ndarray, rel_step: float = REL_STEP, central: bool = False,
+                         friction: bool = True):
+    """(dR1 (N, 2N), dR2 (m, 2N), G or None, cost): the derivatives of the residuals R1 (before
+    the reduction by P) and R2 of the module docstring with respect to (Q, Q_dot) at frozen
+    (Q_ddot, lambda), summed from the local pieces; G = g_Q where the compiled constraint sweep
+    forms it; cost in whole right-hand-side evaluations.  ``friction=False`` leaves out the
+    multiplier-dependent friction forces (the statics' residual has none).  At Q_dot = Q_ddot = 0
+    the Q columns of dR1 are the tangent of the static residual F(Q) + G^T lambda
+    (:func:`sim_core.model.statics.structured_force_tangent`)."""
+    N = model.n_coords
+    Q, Qd = np.array(Q, dtype=float), np.array(Qd, dtype=float)
     m = len(lam)
     dR1 = np.zeros((N, 2 * N))            # d/d(Q, Q_dot) of F + F_mu - M Q_ddot + G^T lambda
     dR2 = np.zeros((m, 2 * N))            # d/d(Q, Q_dot) of G Q_ddot - rhs
@@ -186,7 +242,7 @@ def state_jacobian(model, t: float, y: np.ndarray, rel_step: float = REL_STEP,
     # friction forces (Section 8.3), split into the parts the force offers (friction: one per
     # contact region, so a column re-solves only the regions whose contact point depends on it);
     # their multiplier derivative is formed below (analytic where the force offers at_state)
-    for mf in model.multiplier_forces:
+    for mf in (model.multiplier_forces if friction else []):
         for part in (mf.pieces() if hasattr(mf, "pieces") else [mf]):
             pieces.append((cols_of(part), cols_of(part, "velocity_coords"),
                            lambda Qx, Qdx, part=part: (part.forces(t, Qx, Qdx, lam), None), None))
@@ -222,44 +278,4 @@ def state_jacobian(model, t: float, y: np.ndarray, rel_step: float = REL_STEP,
             dR1[np.ix_(idx, N + idx)] += dr
             n_el += 1
             el_evals += 2 * len(idx) + 1
-
-    dF_dlam = np.zeros((N, m))
-    for mf in model.multiplier_forces:
-        if hasattr(mf, "at_state"):         # analytic: F_mu = E g(lambda), the friction Newton's
-            at = mf.at_state(t, Q, Qd)
-            np.add.at(dF_dlam, at.coords, at.values(lam, gradient=True)[1])
-            continue
-        lx = lam.copy()
-        dF_dlam += _difference(lambda mf=mf: mf.forces(t, Q, Qd, lx), lx, np.arange(m),
-                               rel_step, central)
-
-    # reduced coordinates and the saddle-point solve (X P and P^T X by Model._times_P: a signed
-    # selection where P only selects coordinates)
-    XP = model._times_P
-
-    def PtXP(X):
-        return XP(XP(X).T).T
-
-    Mr, _ = model.reduced_mass_force(t, z, zd)
-    if m:
-        if G is None:
-            G = constraint_terms(model.nonlinear, t, Q, Qd)[1]
-        C = XP(G)
-    else:
-        C = np.zeros((0, n))
-    A = np.zeros((n + m, n + m))
-    A[:n, :n] = -Mr
-    A[:n, n:] = C.T + XP(dF_dlam.T).T
-    A[n:, :n] = C
-    B = np.empty((n + m, 2 * n))
-    B[:n, :n] = PtXP(dR1[:, :N])
-    B[:n, n:] = PtXP(dR1[:, N:])
-    B[n:, :n] = XP(dR2[:, :N])
-    B[n:, n:] = XP(dR2[:, N:])
-    dU = -sla.solve(A, B)
-    jac = np.zeros((2 * n, 2 * n))
-    jac[:n, n:] = np.eye(n)
-    jac[n:] = dU[:n]
-    if return_cost:
-        return jac, el_evals / max(n_el, 1)
-    return jac
+    return dR1, dR2, G, el_evals / max(n_el, 1)
