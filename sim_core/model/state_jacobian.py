@@ -125,12 +125,13 @@ def state_jacobian(model, t: float, y: np.ndarray, rel_step: float = REL_STEP,
 
 def residual_derivatives(model, t: float, Q: np.ndarray, Qd: np.ndarray, Qdd: np.ndarray,
                          lam: np.ndarray, rel_step: float = REL_STEP, central: bool = False,
-                         friction: bool = True):
+                         friction: bool = True, rates: bool = True):
     """(dR1 (N, 2N), dR2 (m, 2N), G or None, cost): the derivatives of the residuals R1 (before
     the reduction by P) and R2 of the module docstring with respect to (Q, Q_dot) at frozen
     (Q_ddot, lambda), summed from the local pieces; G = g_Q where the compiled constraint sweep
     forms it; cost in whole right-hand-side evaluations.  ``friction=False`` leaves out the
-    multiplier-dependent friction forces (the statics' residual has none).  At Q_dot = Q_ddot = 0
+    multiplier-dependent friction forces (the statics' residual has none); ``rates=False`` skips
+    the Q_dot columns (left zero) where only the position tangent is wanted.  At Q_dot = Q_ddot = 0
     the Q columns of dR1 are the tangent of the static residual F(Q) + G^T lambda
     (:func:`sim_core.model.statics.structured_force_tangent`)."""
     N = model.n_coords
@@ -161,9 +162,10 @@ def residual_derivatives(model, t: float, Q: np.ndarray, Qd: np.ndarray, Qdd: np
 
         cols = np.arange(len(idx))
         dR1[np.ix_(idx, idx)] += _difference(by_position, qe, cols, rel_step, central)
-        dR1[np.ix_(idx, N + idx)] += _difference(by_rate, qde, cols, rel_step, central)
+        if rates:
+            dR1[np.ix_(idx, N + idx)] += _difference(by_rate, qde, cols, rel_step, central)
         n_el += 1
-        el_evals += (4 if central else 2) * len(idx) + 1
+        el_evals += (2 if central else 1) * (2 if rates else 1) * len(idx) + 1
 
     # pieces acting through points (point loads, payload, ropes, constraints, friction): each
     # says which coordinates it depends on; they are differenced column by column together, so
@@ -248,7 +250,7 @@ def residual_derivatives(model, t: float, Q: np.ndarray, Qd: np.ndarray, Qdd: np
                            lambda Qx, Qdx, part=part: (part.forces(t, Qx, Qdx, lam), None), None))
 
     base = [None if central else fun(Q, Qd) for _, _, fun, _ in pieces]
-    for which, x in enumerate((Q, Qd)):
+    for which, x in enumerate((Q, Qd) if rates else (Q,)):
         users: dict[int, list[int]] = {}
         for k, piece in enumerate(pieces):
             for j in piece[which]:

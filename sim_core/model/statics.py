@@ -126,7 +126,7 @@ def structured_force_tangent(model: Model, t: float, z: np.ndarray, lam: np.ndar
     Q, Qd = model.full_state(t, z, zero)
     Qdd = np.zeros(model.n_coords)
     dR1 = residual_derivatives(model, t, Q, Qd, Qdd, np.asarray(lam, float), rel_step,
-                               central=central, friction=False)[0]
+                               central=central, friction=False, rates=False)[0]
     XP = model._times_P
     return XP(XP(dR1[:, :model.n_coords]).T).T
 
