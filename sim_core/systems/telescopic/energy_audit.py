@@ -158,6 +158,22 @@ def run_energy_audit(ts, y0: np.ndarray, t_end: float, rtol: float = 1e-6, atol:
     return out
 
 
+def _drive_power_of_outputs(ts, audit: AuditedSystem, res: Result):
+    """P_drive (W) at the output times from the result's ``drive_forces`` (the drive rows'
+    multipliers, in the order of ``ts.drives``) and the prescribed stage rates b'(t): the
+    ``drive_work`` power of :meth:`AuditedSystem.powers` without a right-hand side per output.
+    None where the result has no drive forces or a drive has more than one row."""
+    if "drive_forces" not in res or any(c.m != 1 for c, _ in audit.drives):
+        return None
+    F = np.asarray(res["drive_forces"], dtype=float)
+    column = {name: k for k, name in enumerate(ts.drives)}
+    P = np.zeros(len(res.t))
+    for c, _ in audit.drives:
+        rate = np.array([float(np.atleast_1d(c.target(t)[1])[0]) for t in res.t])
+        P += F[:, column[c.name]] * rate
+    return P
+
+
 def telescopic_energy_check(ts, res: Result) -> dict:
     """Energy balance of a telescopic run's result (``res["state"]``: the integrated states at
     the output times): E = booms' T + U + V, payload and rope strain energy
@@ -174,7 +190,9 @@ def telescopic_energy_check(ts, res: Result) -> dict:
     audit = AuditedSystem(ts, ("drive_work",))
     n = audit.n
     E = np.array([mechanical_energy(ts, t, y[:n], y[n:2 * n]) for t, y in zip(ts_, Y)])
-    P = np.array([audit.powers(t, y[:n], y[n:2 * n])[1][0] for t, y in zip(ts_, Y)])
+    P = _drive_power_of_outputs(ts, audit, res)
+    if P is None:
+        P = np.array([audit.powers(t, y[:n], y[n:2 * n])[1][0] for t, y in zip(ts_, Y)])
     W = np.concatenate([[0.0], np.cumsum(0.5 * (P[1:] + P[:-1]) * np.diff(ts_))])
     quad = 0.0
     if len(ts_) >= 3:
