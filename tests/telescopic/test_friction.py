@@ -294,6 +294,44 @@ def test_compiled_multiplier_newton_equals_the_python_loop(systems, v):
     np.testing.assert_allclose(a, a_ref, rtol=0, atol=1e-12 * np.max(np.abs(a_ref)))
 
 
+@pytest.mark.parametrize("v", [0.2, 0.004, -0.05])
+def test_compiled_resultant_newton_equals_the_python_loop(systems, v):
+    """friction_load = "resultant" (the scenes' default): the friction-multiplier Newton in one
+    compiled call (micro_motion_compiled.resultant_newton) against the Python loop of
+    Model._multiplier_newton from the same warm start, sliding, in the stick band and
+    backwards: the same operations, so the same accelerations and multipliers to round-off;
+    and its g(lambda), dg/dlambda equal FrictionAtState.values' resultant branch."""
+    from sim_core.physics.contact import _sliding_block_contact_numba as micro_motion_compiled
+    if not micro_motion_compiled.AVAILABLE:
+        pytest.skip("numba not installed")
+    _, ts_0, z = systems
+    ts = build_telescopic(TelescopicParams(n_nodes=3, E=2.1e12, payload=1000.0, friction=True,
+                                           friction_load="resultant"))
+    for a, b in zip(ts.model.point_effects, ts_0.model.point_effects):
+        if hasattr(a, "L0"):
+            a.L0 = b.L0
+    m = ts.model
+    Q, Qd = _sliding_state(ts, z, v)
+    zd = m.reduced_state(0.0, Q, Qd)[1]
+    m.accelerations_and_multipliers(0.0, z, zd)
+    g_warm = m._g_warm
+    at = m.multiplier_forces[0].at_state(0.0, Q, Qd)
+    assert at._resultant is not None
+    try:
+        a, lam = m.accelerations_and_multipliers(0.0, z, zd)
+        m._g_warm = g_warm
+        m.multiplier_newton_compiled = False
+        a_ref, lam_ref = m.accelerations_and_multipliers(0.0, z, zd)
+    finally:
+        m.multiplier_newton_compiled = True
+    np.testing.assert_allclose(lam, lam_ref, rtol=0, atol=1e-12 * np.max(np.abs(lam_ref)))
+    np.testing.assert_allclose(a, a_ref, rtol=0, atol=1e-12 * np.max(np.abs(a_ref)))
+    g, dg = micro_motion_compiled.resultant_values(lam, *at._resultant)
+    g_ref, dg_ref = at.values(lam, gradient=True)
+    np.testing.assert_allclose(g, g_ref, rtol=1e-14, atol=0)
+    np.testing.assert_allclose(dg, dg_ref, rtol=0, atol=1e-14 * np.max(np.abs(dg_ref)))
+
+
 @pytest.mark.parametrize("compiled", [True, False])
 def test_multiplier_newton_warm_start(systems, compiled):
     """The multiplier Newton warm-started from the last solution (Model.multiplier_warm_start)

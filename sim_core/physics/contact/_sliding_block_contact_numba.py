@@ -297,6 +297,59 @@ def _multiplier_newton(lam0, L, Lf, Lm, rp, ra, mu, A, AT, BfT, AtA, BftA, Lr, X
     return g, X, True
 
 
+def _resultant_values(lam, Lf, rp, mu):
+    """(g (k,), dg/dlambda (k, m)) of friction regions whose normal load is the transverse
+    resultant (``friction_load = "resultant"``): f_c = Lf_r lambda[rp_r], N = |(f_t, f_b)|,
+    g_r = -mu_r N, dg_r/dlambda[rp_r] = -mu_r (f_t, f_b) / N . Lf_r[1:3] (zero at N = 0) -- the
+    resultant branch of ``FrictionAtState.values``.  Lf (k, 3, p), rp (k, p) multiplier rows."""
+    k, p = rp.shape
+    g = np.empty(k)
+    dg = np.zeros((k, lam.shape[0]))
+    for r in range(k):
+        ft = 0.0
+        fb = 0.0
+        for j in range(p):
+            ft += Lf[r, 1, j] * lam[rp[r, j]]
+            fb += Lf[r, 2, j] * lam[rp[r, j]]
+        N = np.hypot(ft, fb)
+        g[r] = -mu[r] * N
+        if N > 0.0:
+            for j in range(p):
+                dg[r, rp[r, j]] = -mu[r] * (ft * Lf[r, 1, j] + fb * Lf[r, 2, j]) / N
+    return g, dg
+
+
+def _resultant_newton(lam0, L, Lf, rp, mu, tol, max_iter, g0):
+    """The friction-multiplier Newton of ``Model._multiplier_newton`` in one compiled call for
+    regions with the resultant normal load (:func:`resultant_values`): the same iteration as
+    :func:`multiplier_newton` (Newton on r(g) = g - g(lam0 + L g) with I - (dg/dlam) L, the
+    fixed-point step where max |r| grows, stop when a step changes lambda by less than ``tol``
+    relative to max(max |lambda|, 1)) from g0; returns g."""
+    k = L.shape[1]
+    g = g0.copy()
+    lam = lam0 + np.dot(L, g)
+    gv, dg = resultant_values(lam, Lf, rp, mu)
+    r = g - gv
+    eye = np.eye(k)
+    for _ in range(max_iter):
+        step = np.linalg.solve(eye - np.dot(dg, L), -r)
+        g_new = g + step
+        dlam = np.dot(L, step)
+        if np.max(np.abs(dlam)) < tol * max(np.max(np.abs(lam + dlam)), 1.0):
+            g = g_new
+            break
+        lam_new = lam0 + np.dot(L, g_new)
+        gv_new, dg_new = resultant_values(lam_new, Lf, rp, mu)
+        r_new = g_new - gv_new
+        if np.max(np.abs(r_new)) > np.max(np.abs(r)):          # safeguard: fixed-point step
+            g_new = gv.copy()
+            lam_new = lam0 + np.dot(L, g_new)
+            gv_new, dg_new = resultant_values(lam_new, Lf, rp, mu)
+            r_new = g_new - gv_new
+        g, lam, gv, dg, r = g_new, lam_new, gv_new, dg_new, r_new
+    return g
+
+
 if AVAILABLE:            # the callees first: numba resolves the globals when newton compiles
     _spring = numba.njit(cache=True, nogil=True)(_spring)
     _residual = numba.njit(cache=True, nogil=True)(_residual)
@@ -307,3 +360,5 @@ if AVAILABLE:            # the callees first: numba resolves the globals when ne
     newton = numba.njit(cache=True, nogil=True)(_newton)
     regions_values = numba.njit(cache=True, nogil=True)(_regions_values)
     multiplier_newton = numba.njit(cache=True, nogil=True)(_multiplier_newton)
+    resultant_values = numba.njit(cache=True, nogil=True)(_resultant_values)
+    resultant_newton = numba.njit(cache=True, nogil=True)(_resultant_newton)

@@ -296,6 +296,18 @@ class FrictionAtState:
         # all regions in one compiled call (the friction Newton's several evaluations at one
         # state); a single region (a Jacobian column) takes the per-region path
         self._batch = owner._compiled_regions(regions) if batch else None
+        # the resultant normal load: the multiplier Newton in one compiled call
+        # (micro_motion_compiled.resultant_newton) where the regions' multiplier rows are equal
+        # in number
+        self._resultant = None
+        if batch and owner.friction_load == "resultant" and regions:
+            from sim_core.physics.contact import _sliding_block_contact_numba as mmc
+            sizes = {r[2].stop - r[2].start for r in regions}
+            if mmc.AVAILABLE and len(sizes) == 1:
+                self._resultant = (
+                    np.ascontiguousarray(np.stack([r[4] for r in regions]), dtype=float),
+                    np.stack([np.arange(r[2].start, r[2].stop) for r in regions]),
+                    np.array([float(r[6]) for r in regions]))
 
     @property
     def _matrices(self):
@@ -309,7 +321,14 @@ class FrictionAtState:
     def newton(self, lam0, L, tol: float, max_iter: int, g0):
         """g solving g = g(lam0 + L g) by the multiplier Newton of Model._multiplier_newton
         in one compiled call (micro_motion_compiled.multiplier_newton) from g0, or None where
-        it does not apply (no compiled batch, a region that needs the reference path)."""
+        it does not apply (no compiled batch, a region that needs the reference path).  With
+        the resultant normal load: micro_motion_compiled.resultant_newton, the same iteration."""
+        if self._resultant is not None:
+            from sim_core.physics.contact import _sliding_block_contact_numba as mmc
+            return mmc.resultant_newton(np.ascontiguousarray(lam0, dtype=float),
+                                        np.ascontiguousarray(L, dtype=float), *self._resultant,
+                                        float(tol), int(max_iter),
+                                        np.ascontiguousarray(g0, dtype=float))
         if self._batch is None:
             return None
         return self._batch.newton(lam0, L, self.owner._x0, tol, max_iter, g0)
