@@ -128,7 +128,7 @@ def test_bdf_through_breakaway_same_solution_fewer_whole_jacobians(friction_syst
     with the Jacobian it has several times.  With refreshes: fewer whole Jacobians, and the
     same solution as with a whole one at every request, within the integration error: Newton's
     convergence changes only the cost, so the two BDF solutions at rtol 1e-6 may differ by no
-    more than either differs from the exact solution (a BDF run at rtol 1e-9 here).  Both are
+    more than either differs from the exact solution (a BDF run at rtol 1e-8 here).  Both are
     measured in units of (atol + rtol |y|): through the chattering stick of pair 2-3 the global
     error is ~135 such units at t = 0.5 s, the two runs' difference 7-21 units (it depends on
     the friction Newton's warm start, which the shared model carries from test to test)."""
@@ -143,7 +143,7 @@ def test_bdf_through_breakaway_same_solution_fewer_whole_jacobians(friction_syst
     assert st_ref["n_jacobian_refreshes"] >= 1
     assert st_ref["n_jacobians"] < st_whole["n_jacobians"]
     monkeypatch.undo()
-    _, y_exact, _ = integrate(m, y0, 0.6, {**sol, "rtol": 1e-9, "atol": 1e-10})
+    _, y_exact, _ = integrate(m, y0, 0.6, {**sol, "rtol": 1e-8, "atol": 1e-9})
     unit = sol["atol"] + sol["rtol"] * np.abs(y_exact)
     difference = np.max(np.abs(y_ref - y_whole) / unit)
     global_error = np.max(np.abs(y_whole - y_exact) / unit)
