@@ -137,8 +137,9 @@ def constrained_static_equilibrium(model: Model, z0: np.ndarray, t: float = 0.0,
     """Static equilibrium with nonlinear constraints: P^T F(z) + C(z)^T lambda = 0, Phi(z) = 0.
 
     Newton on (z, lambda) with the structured central-difference tangent of the force part
-    (:func:`structured_force_tangent`; the constraint Jacobian C is analytic).  Returns (z, lambda); lambda are the static constraint reactions
-    (e.g. the luffing-cylinder force).  Converged when the force residual is below tol times
+    (:func:`structured_force_tangent`; the constraint Jacobian C is analytic).  Returns
+    (z, lambda); lambda are the static constraint reactions (e.g. the luffing-cylinder force).
+    Converged when the force residual is below tol times
     the largest applied generalized force and |Phi| < 1e-10 m, or when the update stalls at
     round-off.
 
