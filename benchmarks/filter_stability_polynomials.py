@@ -37,10 +37,15 @@ import argparse
 import os
 from math import factorial
 
+import sys
+
 import numpy as np
 from scipy.optimize import linprog
 
 _HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.abspath(os.path.join(_HERE, "..")))
+
+from sim_core.result import atomic_write_bytes  # noqa: E402
 
 
 def region(h_f: float = 0.01, w_free: float = 60.0) -> np.ndarray:
@@ -123,10 +128,7 @@ def main(argv=None) -> None:
     for name, p, s, h in rows:
         lines.append(f"| {name} | {p} | {s} | {h * 1e3:.1f} | {h * 1e3 / s:.2f} | "
                      f"{s / h:.0f} | {(6 / h_dp) / (s / h):.2f} |")
-    tmp = a.out + ".tmp"
-    with open(tmp, "w") as f:
-        f.write("\n".join(lines) + "\n")
-    os.replace(tmp, a.out)
+    atomic_write_bytes(a.out, ("\n".join(lines) + "\n").encode())
     print("wrote", a.out)
 
 

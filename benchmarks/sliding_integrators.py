@@ -49,6 +49,7 @@ from scipy.integrate import BDF, DOP853, RK45, Radau  # noqa: E402
 from _machine import cpu_times, machine_lines  # noqa: E402
 from sim_core import load_scene, simulate  # noqa: E402
 from sim_core.model.state_jacobian import state_jacobian  # noqa: E402
+from sim_core.result import atomic_write_bytes  # noqa: E402
 from sim_core.systems.telescopic.build import build_telescopic, initial_equilibrium  # noqa: E402
 from sim_core.systems.telescopic.schema import params_from_scene  # noqa: E402
 
@@ -179,10 +180,7 @@ def main(argv=None) -> None:
         f"1/s; the largest |λ| outside is {rest:.0f} 1/s.  Dormand–Prince's stability boundary "
         f"along the pair's ray is |hλ| ≈ 3.36, h ≈ {3.36 / abs(pair) * 1e3:.1f} ms.",
     ]
-    tmp = a.out + ".tmp"
-    with open(tmp, "w") as f:
-        f.write("\n".join(lines) + "\n")
-    os.replace(tmp, a.out)
+    atomic_write_bytes(a.out, ("\n".join(lines) + "\n").encode())
     print("wrote", a.out)
 
 

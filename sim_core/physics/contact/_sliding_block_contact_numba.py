@@ -250,6 +250,19 @@ def _regions_values(lam, Lf, Lm, rp, ra, mu, A, AT, BfT, AtA, BftA, Lr, X0, k0, 
     return g, dg, X, status
 
 
+def _newton_step(lam0, L, g, r, dg, lam, tol):
+    """One step of the friction-multiplier Newton (``Model._multiplier_newton``): the step of
+    (I - (dg/dlam) L) step = -r from g; (g_new, lambda at g_new, True) where it changes lambda
+    by less than ``tol`` relative to max(max |lambda|, 1) (converged: the step is taken),
+    else (g_new, lam0 + L g_new, False)."""
+    step = np.linalg.solve(np.eye(L.shape[1]) - np.dot(dg, L), -r)
+    g_new = g + step
+    dlam = np.dot(L, step)
+    if np.max(np.abs(dlam)) < tol * max(np.max(np.abs(lam + dlam)), 1.0):
+        return g_new, lam + dlam, True
+    return g_new, lam0 + np.dot(L, g_new), False
+
+
 def _multiplier_newton(lam0, L, Lf, Lm, rp, ra, mu, A, AT, BfT, AtA, BftA, Lr, X0, k0, eps,
                        kappa, rtol, max_iter_mm, tol, max_iter, g0):
     """The friction-multiplier Newton of ``sim_core.model.model.Model._multiplier_newton`` in one
@@ -264,22 +277,17 @@ def _multiplier_newton(lam0, L, Lf, Lm, rp, ra, mu, A, AT, BfT, AtA, BftA, Lr, X
         return regions_values(lam, Lf, Lm, rp, ra, mu, A, AT, BfT, AtA, BftA, Lr, X, k0, eps,
                               kappa, rtol, max_iter_mm, True)
 
-    k = L.shape[1]
     g = g0.copy()
     lam = lam0 + np.dot(L, g)
     gv, dg, X, st = values(lam, X0)
     if st.any():
         return g, X0, False
     r = g - gv
-    eye = np.eye(k)
     for _ in range(max_iter):
-        step = np.linalg.solve(eye - np.dot(dg, L), -r)
-        g_new = g + step
-        dlam = np.dot(L, step)
-        if np.max(np.abs(dlam)) < tol * max(np.max(np.abs(lam + dlam)), 1.0):
+        g_new, lam_new, done = newton_step(lam0, L, g, r, dg, lam, tol)
+        if done:
             g = g_new
             break
-        lam_new = lam0 + np.dot(L, g_new)
         gv_new, dg_new, Xn, st = values(lam_new, X)
         if st.any():
             return g, X0, False
@@ -325,20 +333,15 @@ def _resultant_newton(lam0, L, Lf, rp, mu, tol, max_iter, g0):
     :func:`multiplier_newton` (Newton on r(g) = g - g(lam0 + L g) with I - (dg/dlam) L, the
     fixed-point step where max |r| grows, stop when a step changes lambda by less than ``tol``
     relative to max(max |lambda|, 1)) from g0; returns g."""
-    k = L.shape[1]
     g = g0.copy()
     lam = lam0 + np.dot(L, g)
     gv, dg = resultant_values(lam, Lf, rp, mu)
     r = g - gv
-    eye = np.eye(k)
     for _ in range(max_iter):
-        step = np.linalg.solve(eye - np.dot(dg, L), -r)
-        g_new = g + step
-        dlam = np.dot(L, step)
-        if np.max(np.abs(dlam)) < tol * max(np.max(np.abs(lam + dlam)), 1.0):
+        g_new, lam_new, done = newton_step(lam0, L, g, r, dg, lam, tol)
+        if done:
             g = g_new
             break
-        lam_new = lam0 + np.dot(L, g_new)
         gv_new, dg_new = resultant_values(lam_new, Lf, rp, mu)
         r_new = g_new - gv_new
         if np.max(np.abs(r_new)) > np.max(np.abs(r)):          # safeguard: fixed-point step
@@ -359,6 +362,7 @@ if AVAILABLE:            # the callees first: numba resolves the globals when ne
     _sensitivity = numba.njit(cache=True, nogil=True)(_sensitivity)
     newton = numba.njit(cache=True, nogil=True)(_newton)
     regions_values = numba.njit(cache=True, nogil=True)(_regions_values)
+    newton_step = numba.njit(cache=True, nogil=True)(_newton_step)
     multiplier_newton = numba.njit(cache=True, nogil=True)(_multiplier_newton)
     resultant_values = numba.njit(cache=True, nogil=True)(_resultant_values)
     resultant_newton = numba.njit(cache=True, nogil=True)(_resultant_newton)
