@@ -178,6 +178,19 @@ class ContactFriction:
                             self.law.mu(float(Qd[s_idx])), geom, m0))
         return FrictionAtState(self, regions, t, batch=only is None)
 
+    def _resultant_rows(self, regions):
+        """The regions' point multiplier rows stacked (k, p) for
+        micro_motion_compiled.resultant_newton, formed once per set of regions; None where it
+        does not apply (no numba, regions with unequal row counts)."""
+        from sim_core.physics.contact import _sliding_block_contact_numba as mmc
+        cache = self.__dict__.setdefault("_resultant_row_stacks", {})
+        key = tuple(r[0] for r in regions)
+        if key not in cache:
+            sizes = {r[2].stop - r[2].start for r in regions}
+            cache[key] = (np.stack([np.arange(r[2].start, r[2].stop) for r in regions])
+                          if mmc.AVAILABLE and len(sizes) == 1 else None)
+        return cache[key]
+
     def _compiled_regions(self, regions):
         """values(lam, x0, gradient) -> (g, dg or None) of all ``regions`` in one compiled call
         (micro_motion_compiled.regions_values), or None where it does not apply (regions
@@ -301,12 +314,10 @@ class FrictionAtState:
         # in number
         self._resultant = None
         if batch and owner.friction_load == "resultant" and regions:
-            from sim_core.physics.contact import _sliding_block_contact_numba as mmc
-            sizes = {r[2].stop - r[2].start for r in regions}
-            if mmc.AVAILABLE and len(sizes) == 1:
+            rows = owner._resultant_rows(regions)
+            if rows is not None:
                 self._resultant = (
-                    np.ascontiguousarray(np.stack([r[4] for r in regions]), dtype=float),
-                    np.stack([np.arange(r[2].start, r[2].stop) for r in regions]),
+                    np.ascontiguousarray(np.stack([r[4] for r in regions]), dtype=float), rows,
                     np.array([float(r[6]) for r in regions]))
 
     @property
