@@ -138,6 +138,15 @@ def mass_tangent(Q, Qd, Qdd, rel_step, eidx, red, sg, n_red, n, q_phi, q_psi, po
 
 
 @_jit
+def _work_arrays(N, nr):
+    """The compiled loops' work arrays: zeros (N,) (the lift's base for rates and
+    accelerations), the full state Q, Q_dot, Q_ddot (N,) and the step's q_ddot_{n+1} iterate
+    and (q, v, a)_{n+1} (nr,)."""
+    return (np.zeros(N), np.empty(N), np.empty(N), np.empty(N), np.empty(nr), np.empty(nr),
+            np.empty(nr), np.empty(nr))
+
+
+@_jit
 def run_steps(q, v, qdd, a, n_steps, h, am, af, beta, gamma, newton_atol, max_iter, refresh_rate,
          rel_step, record_every, predictor, Qp, rows, sgn, eidx, red, sg, n, q_phi, q_psi, pow_p, pow_t,
          q_ds, q_w, q_pos, q_drows, bases, i_s1, rhoAs, Jrots, Ds, hf, grav, inertia,
@@ -154,14 +163,7 @@ def run_steps(q, v, qdd, a, n_steps, h, am, af, beta, gamma, newton_atol, max_it
     N = Qp.shape[0]
     bq = beta * (1.0 - af) / (1.0 - am) * h * h
     bv = gamma * (1.0 - af) / (1.0 - am) * h
-    zeroN = np.zeros(N)
-    Q = np.empty(N)
-    Qd = np.empty(N)
-    Qdd = np.empty(N)
-    x = np.empty(nr)
-    qn = np.empty(nr)
-    vn = np.empty(nr)
-    an = np.empty(nr)
+    zeroN, Q, Qd, Qdd, x, qn, vn, an = _work_arrays(N, nr)
     fresh = False           # tangent formed at the current accepted state
     have = carry[0] > 0.5   # Sinv valid
     eta = carry[1]
@@ -323,14 +325,7 @@ def run_adaptive(q, v, qdd, a, hs, t_out, k_out, max_steps, am, af, beta, gamma,
     nr = q.shape[0]
     n_out = t_out.shape[0]
     N = Qp.shape[0]
-    zeroN = np.zeros(N)
-    Q = np.empty(N)
-    Qd = np.empty(N)
-    Qdd = np.empty(N)
-    x = np.empty(nr)
-    qn = np.empty(nr)
-    vn = np.empty(nr)
-    an = np.empty(nr)
+    zeroN, Q, Qd, Qdd, x, qn, vn, an = _work_arrays(N, nr)
     ash = np.empty(nr)
     bqc = beta * (1.0 - af) / (1.0 - am)
     bvc = gamma * (1.0 - af) / (1.0 - am)
