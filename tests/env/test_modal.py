@@ -99,15 +99,21 @@ def test_scene_route_runs_the_rom():
     assert res.stats["real_time_factor"] > 20
 
 
-def _deflections(full, rom):
-    """Deflection of the tip from the table's static tip at the current stroke (m), (n, 2)
-    global X, Z; the full model's is referred to its own initial equilibrium."""
+def _full_deflection(full):
+    """(deflection of the full model's tip from the table's static tip at the current stroke,
+    referred to its own initial equilibrium (m), (n, 2) global X, Z; the tables)."""
     p = params()
     tb = tables_for(p.payload, p.luffing_angle_deg, 4)
     L = p.stroke0 + full["piston_stroke"]
     rs = np.array([tb.static_tip(x)[0] for x in L])
     d_full = full["tip_position"] - full["tip_position"][0] - (rs - rs[0])
-    return d_full[:, [0, 2]], rom["tip_deflection"][:, [0, 2]], tb
+    return d_full[:, [0, 2]], tb
+
+
+def _deflections(full, rom):
+    """(_full_deflection's, the ROM's tip deflection (n, 2) global X, Z, the tables)."""
+    d_full, tb = _full_deflection(full)
+    return d_full, rom["tip_deflection"][:, [0, 2]], tb
 
 
 def _peak_frequency(t, x):
@@ -191,19 +197,16 @@ def test_rom_mismatch_on_the_window_is_the_retraction_rope_state():
         initial_equilibrium,
         simulate_telescopic,
     )
-    from sim_core.systems.telescopic.modal import linearize_at, reference_rope_lengths
+    from sim_core.systems.telescopic.modal import _ropes, linearize_at, reference_rope_lengths
 
     p = params()
     t_end = WINDOW["t_ramp"] + WINDOW["t_hold_end"]
     full = simulate_telescopic(p, t_end, 401, 1e-7, 1e-8)
     ts = build_telescopic(p)
     initial_equilibrium(ts)
-    full_ropes = {pe.name: pe.L0 for pe in ts.model.point_effects if hasattr(pe, "L0")}
+    full_ropes = {name: rope.L0 for name, rope in _ropes(ts.model).items()}
     assert full["rope_tensions"][0, 1] == 0.0                  # slack in the full model
-    tb = tables_for(p.payload, p.luffing_angle_deg, 4)
-    L = p.stroke0 + full["piston_stroke"]
-    rs = np.array([tb.static_tip(x)[0] for x in L])
-    d_full = (full["tip_position"] - full["tip_position"][0] - (rs - rs[0]))[:, [0, 2]]
+    d_full, _ = _full_deflection(full)
     sched = CubicSmoothstepSchedule(v_max=p.v_max, t_ramp=p.t_ramp, t_hold_end=p.t_hold_end)
     theta = np.radians(p.luffing_angle_deg)
     n_perp = np.array([-np.sin(theta), np.cos(theta)])

@@ -182,10 +182,10 @@ class ContactFriction:
         """The regions' point multiplier rows stacked (k, p) for
         micro_motion_compiled.resultant_newton, formed once per set of regions; None where it
         does not apply (no numba, regions with unequal row counts)."""
-        from sim_core.physics.contact import _sliding_block_contact_numba as mmc
         cache = self.__dict__.setdefault("_resultant_row_stacks", {})
         key = tuple(r[0] for r in regions)
         if key not in cache:
+            from sim_core.physics.contact import _sliding_block_contact_numba as mmc
             sizes = {r[2].stop - r[2].start for r in regions}
             cache[key] = (np.stack([np.arange(r[2].start, r[2].stop) for r in regions])
                           if mmc.AVAILABLE and len(sizes) == 1 else None)
