@@ -202,8 +202,9 @@ def integrate(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
       stiffest bending mode;
     * ``"auto"``: RK45 and BDF alternate as :class:`MethodSwitch` decides (RK45 -> BDF when
       :class:`StiffnessDetector` finds the step stability-limited, back to RK45 after a
-      stretch whose length adapts to which method was cheaper); the statistics record the
-      number of switches and the first switch to BDF.
+      stretch whose length adapts to which method was cheaper; with a model's
+      ``friction_in_slope_band``, BDF only while it is True); the statistics record the
+      number of switches, the first switch to BDF and the stiffness alarms that kept RK45.
 
     Returns (t, y, stats); raises SimulationError with the time, step and last good state on
     failure or non-finite values, when the optional wall-clock budget ``sol["max_wall_s"]`` (s)
@@ -249,7 +250,10 @@ def integrate(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
     # finite differences of a small system
     probe = structured or len(y0) <= 100
     fresh = (lambda s: stretch["jac"](s.t, s.y)) if structured else (lambda s: s.jac(s.t, s.y))
-    switch = MethodSwitch(rhs, fresh_jacobian=fresh if probe else None) \
+    n = len(y0) // 2
+    in_band = getattr(model, "friction_in_slope_band", None)
+    band = (lambda t, y: in_band(t, y[:n], y[n:])) if in_band is not None else None
+    switch = MethodSwitch(rhs, fresh_jacobian=fresh if probe else None, stiff_friction=band) \
         if method == "auto" else None
     njev = 0                  # Jacobians of BDF solvers already replaced by a switch
     newton_limit = bdf_newton_limit(sol.get("bdf_newton_iterations", BDF_NEWTON_ITERATIONS))
@@ -286,6 +290,7 @@ def integrate(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
         if switch is not None:
             out["n_method_switches"] = len(switch.switches)
             out["n_bdf_kept"] = switch.kept_bdf     # stretch ends without a hand-back trial
+            out["n_rk45_kept"] = switch.kept_rk45   # stiffness alarms outside the friction band
             out["first_switch_to_bdf_s"] = switch.switches[0][0] if switch.switches else -1.0
             out["last_switch_s"] = switch.switches[-1][0] if switch.switches else -1.0
         return out

@@ -3,7 +3,8 @@
 RK45 runs while its step is set by accuracy; when :class:`StiffnessDetector` finds the step
 limited by stability, :class:`MethodSwitch` hands over to BDF, and back to RK45 when the
 spectral radius of a fresh Jacobian (:func:`spectral_radius`) says the explicit method's
-stability region holds the step again.
+stability region holds the step again.  Where the model tells whether its friction law is in
+its stiff slope band (``Model.friction_in_slope_band``), BDF runs only while it is.
 """
 
 from __future__ import annotations
@@ -93,12 +94,22 @@ class MethodSwitch:
     Jacobian almost every step), its next stretch is halved and RK45
     ignores the detector for a cool-down that doubles with every such loss.  Costs are counted
     in model evaluations, not wall time, so a run is reproducible.  ``switches`` lists (t s,
-    method switched to)."""
+    method switched to).
+
+    ``stiff_friction(t, y)`` (optional; None: no such information): whether the model's
+    friction law is in its slope band, the stiffness BDF is for.  While it is False a detector
+    alarm keeps RK45 (counted in ``kept_rk45``): the stiffness is then the stress filter's
+    eigenvalue pair, where BDF's longer steps leave a global error on the oscillating payload
+    and booms far above RK45's at the same tolerance (benchmarks/results/
+    tolerance_accuracy.md); and a BDF step that ends with it False hands back to RK45."""
 
     def __init__(self, rhs, window: int = 30, bdf_steps: int = 40,
-                 max_bdf_steps: int = 5000, stay_factor: float = 2.0, fresh_jacobian=None):
+                 max_bdf_steps: int = 5000, stay_factor: float = 2.0, fresh_jacobian=None,
+                 stiff_friction=None):
         self.rhs = rhs
         self.fresh_jacobian = fresh_jacobian      # solver -> Jacobian at its state, or None
+        self.stiff_friction = stiff_friction      # (t, y) -> bool or None, or None
+        self.kept_rk45 = 0             # detector alarms without stiff friction (RK45 kept)
         self.window = window
         self.bdf_steps, self.min_bdf_steps, self.max_bdf_steps = bdf_steps, bdf_steps, max_bdf_steps
         self.detector = StiffnessDetector()
@@ -112,6 +123,14 @@ class MethodSwitch:
         self.stay_factor = stay_factor
         self.kept_bdf = 0              # stretch ends where BDF stayed (no hand-back trial)
         self.last_bdf_h_rho = 0.0
+
+    def _friction_stiff(self, solver) -> bool:
+        """Whether BDF may run at the solver's state: the model's friction is in its slope
+        band (``stiff_friction``; True without that information)."""
+        if self.stiff_friction is None:
+            return True
+        stiff = self.stiff_friction(solver.t, solver.y)
+        return True if stiff is None else bool(stiff)
 
     @staticmethod
     def _cost(a: tuple[float, float], b: tuple[float, float]) -> float:
@@ -128,9 +147,17 @@ class MethodSwitch:
                 return solver
             if not self.detector.update(solver):
                 return solver
+            if not self._friction_stiff(solver):
+                self.detector = StiffnessDetector()
+                self.kept_rk45 += 1
+                return solver
             self.rk45_cost = self._cost(self.recent[0], now)
             self.n_bdf = 0
             new, name = make(BDF, solver.t, solver.y), "BDF"
+        elif not self._friction_stiff(solver):      # every contact slides: back to RK45
+            self.detector = StiffnessDetector()
+            self.recent = [now]
+            new, name = make(RK45, solver.t, solver.y), "RK45"
         else:
             self.n_bdf += 1
             if self.n_bdf < self.bdf_steps:

@@ -778,6 +778,18 @@ class Model:
         self._g_warm = (idx, g)
         return zdd0 + Z @ g, lam0 + L @ g
 
+    def friction_in_slope_band(self, t: float, z: np.ndarray, zd: np.ndarray) -> bool | None:
+        """Whether a multiplier force's friction law is in its slope band at (t, z, z_dot),
+        where it makes the dynamics stiff (ContactFriction.in_slope_band: a contact sticking,
+        breaking away or coming to stick); None where no multiplier force says (no friction).
+        The ``"auto"`` method (:class:`sim_core.integrate.switching.MethodSwitch`) runs BDF only
+        while it is True."""
+        forces = [mf for mf in self.multiplier_forces if hasattr(mf, "in_slope_band")]
+        if not forces:
+            return None
+        _, Qd = self.full_state(t, z, zd)
+        return any(mf.in_slope_band(Qd) for mf in forces)
+
     def nonsmooth_rate_columns(self) -> np.ndarray:
         """Columns of the state Jacobian d(y')/dy, y = (z, z_dot), that carry a non-smooth
         rate law: the reduced rates the multiplier forces' velocity coordinates depend on

@@ -199,3 +199,25 @@ def test_second_order_newton_lu_equals_the_whole_lu():
     assert LU[0] == "full"
     np.testing.assert_allclose(newton.solve_lu(LU, b.copy()), np.linalg.solve(A, b),
                                rtol=1e-10, atol=1e-12)
+
+
+class StiffIntervalNotFriction(StiffInterval):
+    """StiffInterval whose stiffness the model declares not to be a friction law's
+    (``friction_in_slope_band`` False, as a telescopic model with every contact sliding)."""
+
+    def friction_in_slope_band(self, t, z, zd):
+        return False
+
+
+def test_auto_keeps_rk45_where_the_stiffness_is_not_the_frictions():
+    """With the model saying its friction is outside the slope band, the detector's alarms
+    keep RK45 (no switch; the alarms are counted) and the run is RK45's: BDF is reserved for
+    the friction law's stiffness (MethodSwitch, ``stiff_friction``)."""
+    sol = {"rtol": 1e-6, "atol": 1e-9, "n_output": 41}
+    t, y, st = integrate(StiffIntervalNotFriction(), np.zeros(1), 1.0, {**sol, "method": "auto"})
+    _, y_rk, st_rk = integrate(StiffIntervalNotFriction(), np.zeros(1), 1.0,
+                               {**sol, "method": "RK45"})
+    assert st["n_method_switches"] == 0
+    assert st["n_rk45_kept"] >= 1
+    assert st["n_rhs"] == st_rk["n_rhs"]
+    np.testing.assert_array_equal(y, y_rk)

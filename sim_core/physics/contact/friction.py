@@ -158,6 +158,12 @@ class ContactFriction:
         """Rates in the friction law: the contact coordinates' (s_dot of Eq. 65)."""
         return np.array([s_idx for _, _, s_idx, _ in self.regions], dtype=int)
 
+    def in_slope_band(self, Qd) -> bool:
+        """Whether a contact coordinate's rate s_dot (Eq. 65) lies in the friction law's slope
+        band |s_dot| < 2 v_eps (FrictionLaw.in_slope_band): a contact sticking, breaking away
+        or coming to stick."""
+        return self.law.in_slope_band(Qd[self.velocity_coords(None)])
+
     def at_state(self, t, Q, Qd, only=None) -> "FrictionAtState":
         """The friction as a function of the multipliers alone, at the state (Q, Qd): the
         section maps and mu(s_dot) are formed once here, not in every multiplier iteration.

@@ -198,6 +198,12 @@ class FrictionLaw:
         out = np.where(a <= self.v_eps, self.mu_static * va / self.v_eps, outer)
         return float(out) if out.ndim == 0 else out
 
+    def in_slope_band(self, v) -> bool:
+        """Whether any rate v (m/s) lies where mu(v) varies, |v| < 2 v_eps: there the law
+        acts as a damper (mu_s N / v_eps near stick, the falling branch above v_eps) and makes
+        the dynamics stiff; outside it mu = mu_d sign(v) is constant."""
+        return bool(np.any(np.abs(np.asarray(v, dtype=float)) < 2.0 * self.v_eps))
+
     def dmu_dv(self, v):
         """d mu / dv, 1/(m/s) (one-sided from above at |v| = v_eps, where mu is only C0)."""
         va = np.asarray(v, dtype=float)
