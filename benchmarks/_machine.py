@@ -1,5 +1,6 @@
 """The machine state a benchmark table states: processor, cores and affinity, each core's busy
-share during the run (/proc/stat), load average, versions, commit and time."""
+share during the run (/proc/stat), load average, versions, commit and time; and the table's
+atomic write (:func:`write_markdown`)."""
 
 from __future__ import annotations
 
@@ -78,3 +79,13 @@ def machine_lines(cpu0, cpu1, load0, load1) -> list[str]:
             f"{platform.platform()}",
             f"- commit {commit()}",
             f"- {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC"]
+
+
+def write_markdown(path: str, lines: list[str]) -> None:
+    """Write the table's ``lines`` to ``path`` atomically (sim_core.result.atomic_write_bytes)
+    and say so."""
+    import sys
+    sys.path.insert(0, ROOT)
+    from sim_core.result import atomic_write_bytes
+    atomic_write_bytes(path, ("\n".join(lines) + "\n").encode())
+    print("wrote", path)

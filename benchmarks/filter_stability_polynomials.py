@@ -52,8 +52,10 @@ from scipy.optimize import linprog
 
 _HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.abspath(os.path.join(_HERE, "..")))
+sys.path.insert(0, _HERE)
 
-from sim_core.result import atomic_write_bytes  # noqa: E402
+from _machine import write_markdown  # noqa: E402
+
 
 
 def region(h_f: float = 0.01, w_free: float = 60.0) -> np.ndarray:
@@ -200,8 +202,7 @@ def main(argv=None) -> None:
     for k, h, h_ray in adams:
         lines.append(f"| {k} | {h * 1e3:.2f} | {h_ray * 1e3:.2f} | {2 / h_ray:.0f} | "
                      f"{(6 / h_dp) / (2 / h_ray):.2f} |")
-    atomic_write_bytes(a.out, ("\n".join(lines) + "\n").encode())
-    print("wrote", a.out)
+    write_markdown(a.out, lines)
 
 
 if __name__ == "__main__":

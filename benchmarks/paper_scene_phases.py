@@ -40,9 +40,8 @@ sys.path.insert(0, _HERE)
 
 from scipy.integrate import RK45  # noqa: E402
 
-from _machine import cpu_times, machine_lines  # noqa: E402
+from _machine import cpu_times, machine_lines, write_markdown  # noqa: E402
 from sim_core import load_scene, simulate  # noqa: E402
-from sim_core.result import atomic_write_bytes  # noqa: E402
 from sliding_integrators import start_state, system  # noqa: E402
 
 SCENE = "telescopic_extraction"
@@ -170,8 +169,7 @@ def main(argv=None) -> None:
                           for i, c in top.most_common(2))
         lines.append(f"| {t0:g} | {steps} | {nfev} | {h_med * 1e3:.2f} | {norm:.2f} | {share} |")
         print(lines[-1], flush=True)
-    atomic_write_bytes(a.out, ("\n".join(lines) + "\n").encode())
-    print("wrote", a.out)
+    write_markdown(a.out, lines)
 
 
 if __name__ == "__main__":

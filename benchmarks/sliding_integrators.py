@@ -56,11 +56,10 @@ sys.path.insert(0, _HERE)
 import scipy.linalg as sla  # noqa: E402
 from scipy.integrate import BDF, DOP853, RK45, Radau  # noqa: E402
 
-from _machine import cpu_times, machine_lines  # noqa: E402
+from _machine import cpu_times, machine_lines, write_markdown  # noqa: E402
 from sim_core import load_scene, simulate  # noqa: E402
 from sim_core.integrate.generalized_alpha import integrate_generalized_alpha  # noqa: E402
 from sim_core.model.state_jacobian import state_jacobian  # noqa: E402
-from sim_core.result import atomic_write_bytes  # noqa: E402
 from sim_core.systems.telescopic.build import build_telescopic, initial_equilibrium  # noqa: E402
 from sim_core.systems.telescopic.schema import params_from_scene  # noqa: E402
 
@@ -304,8 +303,7 @@ def main(argv=None) -> None:
         f"1/s; the largest |λ| outside is {rest:.0f} 1/s.  Dormand–Prince's stability boundary "
         f"along the pair's ray is |hλ| ≈ 3.36, h ≈ {3.36 / abs(pair) * 1e3:.1f} ms.",
     ]
-    atomic_write_bytes(a.out, ("\n".join(lines) + "\n").encode())
-    print("wrote", a.out)
+    write_markdown(a.out, lines)
 
 
 if __name__ == "__main__":

@@ -27,9 +27,8 @@ _HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.abspath(os.path.join(_HERE, "..")))
 sys.path.insert(0, _HERE)
 
-from _machine import cpu_times, machine_lines  # noqa: E402
+from _machine import cpu_times, machine_lines, write_markdown  # noqa: E402
 from sim_core import load_scene, simulate  # noqa: E402
-from sim_core.result import atomic_write_bytes  # noqa: E402
 
 SCENE = "telescopic_extraction"
 TOLERANCES = ((1e-6, 1e-7), (1e-5, 1e-6), (1e-4, 1e-5), (1e-2, 1e-7), (1e-2, 1e-3))
@@ -83,8 +82,7 @@ def main(argv=None) -> None:
     for rtol, atol, method, wall, steps, h_max, e_tip, e_f in rows:
         lines.append(f"| {rtol:.0e} | {atol:.0e} | {method} | {wall:.1f} | {steps} | "
                      f"{h_max * 1e3:.0f} | {e_tip:.1e} | {e_f:.1e} |")
-    atomic_write_bytes(a.out, ("\n".join(lines) + "\n").encode())
-    print("wrote", a.out)
+    write_markdown(a.out, lines)
 
 
 if __name__ == "__main__":
