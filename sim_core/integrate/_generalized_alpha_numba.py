@@ -114,7 +114,7 @@ def mass_tangent(Q, Qd, Qdd, rel_step, eidx, red, sg, n_red, n, q_phi, q_psi, po
     DP, DR = ec.differences_batch_kernel(QE, QDE, QDDE, HQ, HQD, n, q_phi, q_psi, pow_p,
                                             pow_t, q_ds, q_w, q_pos, q_drows, bases, i_s1,
                                             rhoAs, Jrots, Ds, hf, grav, inertia, elasticity,
-                                            gravity, cstep, no_acc)
+                                            gravity, cstep, no_acc, True)
     Mr = np.zeros((n_red, n_red))
     Kr = np.zeros((n_red, n_red))
     Cr = np.zeros((n_red, n_red))

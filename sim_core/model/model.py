@@ -417,14 +417,14 @@ class Model:
             gov = self._governor = workers.Governor()
         return gov
 
-    def _element_differences_started(self, Q, Qd, Qdd, steps):
+    def _element_differences_started(self, Q, Qd, Qdd, steps, rates=True):
         """Start the structured Jacobian's element columns, element by element
         (:meth:`element_compiled.ElementBatch.differences`; with ``element_thread`` on the
         worker thread, and the calling thread takes the rest when it waits) and return a
         function that waits for them: per element (d(F - M Qdd)/dq, dF/dq_dot), in the order
         of :meth:`element_indices`.  ``steps(x)``:
-        the forward-difference steps of a coordinate vector.  None where the batch does not
-        cover the model."""
+        the forward-difference steps of a coordinate vector; ``rates`` False: dF/dq_dot left
+        zero.  None where the batch does not cover the model."""
         plan = self._element_batch_plan(Q, Qd)
         if plan is None:
             return None
@@ -439,7 +439,7 @@ class Model:
         def element(e):
             r = slice(e, e + 1)
             DP[r], DR[r] = batch.differences(QE[r], QDE[r], QDDE[r], HQ[r], HQD[r], kw["h"],
-                                             kw["g"], element=e)
+                                             kw["g"], element=e, rates=rates)
         shared = workers.SharedElements(E, element)
 
         def job():

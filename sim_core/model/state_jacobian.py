@@ -146,9 +146,16 @@ def residual_derivatives(model, t: float, Q: np.ndarray, Qd: np.ndarray, Qdd: np
     # columns skip the mass matrix (M_e does not depend on rates), and on the numpy path reuse
     # the position-level kinematics
     # the compiled batch of all elements' columns (on the worker thread, while the point pieces
-    # below are differenced on this one), else element by element here
-    batch = None if central else model._element_differences_started(
-        Q, Qd, Qdd, lambda x: _steps(x, rel_step))
+    # below are differenced on this one), else element by element here.  The compiled sweeps
+    # take forward steps; a central difference is the mean of the sweeps with steps +h and -h:
+    # (f(x + h) - f(x)) / h and (f(x - h) - f(x)) / (-h) average to (f(x + h) - f(x - h)) / 2h
+    signs = (1.0, -1.0) if central else (1.0,)
+    weight = 1.0 / len(signs)
+
+    def signed_steps(sign):
+        return lambda x: sign * _steps(x, rel_step)
+
+    batch = model._element_differences_started(Q, Qd, Qdd, signed_steps(1.0), rates)
     for el, idx in ([] if batch is not None else model.element_indices()):
         qdde = Qdd[idx]
         qe, qde = Q[idx].copy(), Qd[idx].copy()
@@ -189,11 +196,11 @@ def residual_derivatives(model, t: float, Q: np.ndarray, Qd: np.ndarray, Qdd: np
 
     # payload and ropes in one compiled program (point_effects.CompiledPointEffects.jacobian)
     # where it covers them, else as pieces below
-    pe_batch = None if central else model._compiled_point_effects()
-    if pe_batch is not None:
-        dQ, dQd = pe_batch.jacobian(Q, Qd, Qdd, lambda x: _steps(x, rel_step))
-        dR1[:, :N] += dQ
-        dR1[:, N:] += dQd
+    pe_batch = model._compiled_point_effects()
+    for sign in (signs if pe_batch is not None else ()):
+        dQ, dQd = pe_batch.jacobian(Q, Qd, Qdd, signed_steps(sign))
+        dR1[:, :N] += weight * dQ
+        dR1[:, N:] += weight * dQd
     # F_pe - M_pe Q_ddot of the effects outside the compiled program (slider seats)
     for pe in (pe_batch.uncompiled if pe_batch is not None else model.point_effects):
         def point_effect(Qx, Qdx, pe=pe):
@@ -212,16 +219,17 @@ def residual_derivatives(model, t: float, Q: np.ndarray, Qd: np.ndarray, Qdd: np
     # part of the complex-step Jacobian G(Q + i h Q_dot) / h
     xi1, xi2 = model.baumgarte
     row = 0
-    prog = None if central or not COMPILED_CONSTRAINT_COLUMNS else program_for(model.nonlinear)
+    prog = program_for(model.nonlinear) if COMPILED_CONSTRAINT_COLUMNS else None
     G = None                               # g_Q at (Q, Q_dot), where the sweep forms it
     if prog is not None:        # all constraint pieces in one compiled sweep (same differences)
         b0, bd, bdd = targets(model.nonlinear, t)
         deps = prog.dependencies(Q)
         cols = np.flatnonzero(deps.any(axis=0))
-        d1, d2 = prog.columns(Q, Qd, Qdd, lam, b0, bd, bdd, xi1, xi2, cols,
-                              _steps(Q[cols], rel_step), deps)
-        dR1[:, cols] += d1
-        dR2[:, cols] += d2
+        for sign in signs:
+            d1, d2 = prog.columns(Q, Qd, Qdd, lam, b0, bd, bdd, xi1, xi2, cols,
+                                  signed_steps(sign)(Q[cols]), deps)
+            dR1[:, cols] += weight * d1
+            dR2[:, cols] += weight * d2
         _, G, _, G_rate = prog.terms(Q, Qd, rate_part=True)     # d/dQ_dot as below
         dR2[:, N:] += 2.0 * G_rate + 2.0 * xi1 * G
     for c in ([] if prog is not None else model.nonlinear):
@@ -274,10 +282,15 @@ def residual_derivatives(model, t: float, Q: np.ndarray, Qd: np.ndarray, Qdd: np
                     dR2[pieces[k][3], col] += (u[1] - l[1]) * scale
 
     if batch is not None:
-        DP, DR = batch()
-        for (_, idx), dp, dr in zip(model.element_indices(), DP, DR):
-            dR1[np.ix_(idx, idx)] += dp
-            dR1[np.ix_(idx, N + idx)] += dr
-            n_el += 1
-            el_evals += 2 * len(idx) + 1
+        for sign in signs:
+            if sign < 0.0:                 # the -h sweep after the +h one (one worker)
+                batch = model._element_differences_started(Q, Qd, Qdd, signed_steps(sign),
+                                                             rates)
+            DP, DR = batch()
+            for (_, idx), dp, dr in zip(model.element_indices(), DP, DR):
+                dR1[np.ix_(idx, idx)] += weight * dp
+                dR1[np.ix_(idx, N + idx)] += weight * dr
+                if sign > 0.0:
+                    n_el += 1
+                el_evals += (2 if rates else 1) * len(idx) + 1
     return dR1, dR2, G, el_evals / max(n_el, 1)

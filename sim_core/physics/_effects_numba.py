@@ -499,13 +499,14 @@ def _mass_force_batch(QE, QDE, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos, 
 
 def _differences_batch(QE, QDE, QDDE, HQ, HQD, n, q_phi, q_psi, pow_p, pow_t, q_ds, q_w, q_pos,
                        q_drows, bases, i_s1, rhoAs, Jrots, Ds, h, grav, inertia,
-                       elasticity, gravity, cstep, no_acc):
+                       elasticity, gravity, cstep, no_acc, rates):
     """Forward differences of E elements (the structured Jacobian's element columns,
     sim_core.model.state_jacobian): per element d(F - M qdd)/dq and dF/dq_dot (nq, nq), steps HQ,
-    HQD (exactly representable), the same kernel calls as the one-by-one path."""
+    HQD (exactly representable), the same kernel calls as the one-by-one path.  ``rates``
+    False: the dF/dq_dot columns are left zero (the statics' tangent needs none)."""
     E, nq = QE.shape
     DP = np.empty((E, nq, nq))
-    DR = np.empty((E, nq, nq))
+    DR = np.zeros((E, nq, nq))
     for e in range(E):
         qe = QE[e].copy()
         qde = QDE[e].copy()
@@ -520,6 +521,8 @@ def _differences_batch(QE, QDE, QDDE, HQ, HQD, n, q_phi, q_psi, pow_p, pow_t, q_
             qe[j] = x
             for i in range(nq):
                 DP[e, i, j] = (R[i] - R0[i]) / HQ[e, j]
+            if not rates:
+                continue
             x = qde[j]
             qde[j] = x + HQD[e, j]
             F = _compiled_mass_force(qe, qde, *args, no_acc)[1]
@@ -690,11 +693,14 @@ class ElementBatch:
             QE, QDE, *self.element_arguments(), float(h), grav, self.inertia, self.elasticity,
             bool(np.any(grav != 0.0)), float(cstep), _NO_ACC)
 
-    def differences(self, QE, QDE, QDDE, HQ, HQD, h, g, cstep=COMPLEX_STEP, element=None):
+    def differences(self, QE, QDE, QDDE, HQ, HQD, h, g, cstep=COMPLEX_STEP, element=None,
+                    rates=True):
         """(d(F - M qdd)/dq, dF/dq_dot) (E, nq, nq) of every element by forward differences
         with the steps HQ, HQD (E, nq) at the rows of QE, QDE, QDDE (no finite check here,
-        as in __call__); ``element``: the rows are this one element's alone (E = 1)."""
+        as in __call__); ``element``: the rows are this one element's alone (E = 1);
+        ``rates`` False: dF/dq_dot left zero."""
         grav = np.ascontiguousarray(g, dtype=float)
         return _compiled_differences_batch(
             QE, QDE, QDDE, HQ, HQD, *self.element_arguments(element), float(h), grav,
-            self.inertia, self.elasticity, bool(np.any(grav != 0.0)), float(cstep), _NO_ACC)
+            self.inertia, self.elasticity, bool(np.any(grav != 0.0)), float(cstep), _NO_ACC,
+            bool(rates))
