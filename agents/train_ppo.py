@@ -13,7 +13,7 @@ et al. 2018; Johannink et al. 2019).  ``--residual none`` trains the acceleratio
 
 Stable-Baselines3 PPO with an MLP policy, observation and reward normalisation (VecNormalize),
 a SubprocVecEnv with one env process per available core (``--vec dummy`` runs them in-process,
-which is faster for the cheap modal env on a loaded machine: see benchmarks/env_speed.md),
+which is faster for the cheap modal env on a loaded machine: see benchmarks/results/env_speed.md),
 a progress bar, optional TensorBoard logging (``--tensorboard DIR``, needs ``tensorboard``),
 periodic checkpoints, and on exit:
 

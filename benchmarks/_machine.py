@@ -64,10 +64,13 @@ def machine_lines(cpu0, cpu1, load0, load1) -> list[str]:
     for c in sorted(cpu1):
         if c in cpu0 and cpu1[c][1] > cpu0[c][1]:
             share = (cpu1[c][0] - cpu0[c][0]) / (cpu1[c][1] - cpu0[c][1])
-            who = "this benchmark" if aff == [c] else "other processes"
-            busy.append(f"core {c} {100 * share:.0f} % ({who}"
-                        + ("" if aff == [c] else ": " + ("busy" if share > 0.5 else "idle"))
-                        + ")")
+            if aff == [c]:
+                who = "this benchmark"
+            elif c in aff:           # not pinned: this benchmark may run on every core it has
+                who = "this benchmark and any other processes"
+            else:
+                who = "other processes: " + ("busy" if share > 0.5 else "idle")
+            busy.append(f"core {c} {100 * share:.0f} % ({who})")
     return [f"- CPU: {model}; {os.cpu_count()} logical processors; this run pinned to "
             f"{'core ' + str(aff[0]) if len(aff) == 1 else 'cores ' + str(aff)}"
             + (" (`taskset -c 0`)" if aff == [0] else " (NOT pinned to one core)"),

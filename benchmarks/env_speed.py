@@ -1,34 +1,43 @@
 """boom_env speed: env steps per second and real-time factor (simulated s per wall s).
 
-    PYTHONPATH=. OPENBLAS_NUM_THREADS=1 python benchmarks/env_speed.py [--paper-steps 20]
+    OPENBLAS_NUM_THREADS=1 python benchmarks/env_speed.py [--paper-steps 100]
 
-    PYTHONPATH=. OPENBLAS_NUM_THREADS=1 python benchmarks/env_speed.py --only vec-async-4 --vec-steps 2000
+    OPENBLAS_NUM_THREADS=1 python benchmarks/env_speed.py --only vec-async-4 --vec-steps 2000
 
-Writes benchmarks/env_speed.md.  Cases: fidelity "rl" (modal ROM, one process), vector envs of
-2 and 4 copies (gym.make_vec, "sync": one process steps them in turn, "async": one worker
-process each), and a short "paper" estimate (full sim_core model, n_nodes 3, a few control
-steps; the static-equilibrium reset is timed separately).  Random actions (uniform in [-1, 1],
-seeded); episodes are reset when they end (the vector envs reset their sub-envs themselves).
-``--only CASE`` runs one case, prints its row and writes nothing: for timing whole processes
-from outside.  ``--machine-state`` is the table's note on the machine's load ("side by side
-with other work" unless measured on an idle machine); the 1-minute load average before and
-after the run is recorded with it.  The numbers are wall-clock.  A "## Notes" section at the
-end of env_speed.md (e.g. whole-process timings of ``--only`` runs) is kept when the table is
-rewritten.
+Writes benchmarks/results/env_speed.md with the machine state (:func:`_machine.machine_lines`:
+each core's busy share during the run, load average, commit).  Run it unpinned on an idle
+machine: the async vector envs put one worker process on each core.  Cases: fidelity "rl"
+(modal ROM, one process), vector envs of 2 and 4 copies (gym.make_vec, "sync": one process
+steps them in turn, "async": one worker process each), and "paper" (the full sim_core model,
+``paper_n_nodes`` 3, frictionless: the env's defaults), its first reset (the static
+equilibrium of the full model) timed separately from its steps, once in this process (both
+cores: the element worker thread may take the second) and once in a child process pinned to
+core 0 (one core per env, as in a vector env with one process per core).  Random actions (uniform in
+[-1, 1], seeded); episodes are reset when they end (the vector envs reset their sub-envs
+themselves).  ``--only CASE`` runs one case, prints its row and writes nothing: for timing
+whole processes from outside.  The numbers are wall-clock.
 """
 
 from __future__ import annotations
 
 import argparse
+import ast
 import os
-import platform
+import subprocess
+import sys
 import time
-from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
 
-import boom_env  # noqa: F401
+_HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.abspath(os.path.join(_HERE, "..")))
+sys.path.insert(0, _HERE)
+
+import boom_env  # noqa: E402, F401
+from _machine import cpu_times, machine_lines, write_markdown  # noqa: E402
+
+OUT = os.path.join(_HERE, "results", "env_speed.md")
 
 ENV_ID = "boom_env/TelescopicExtraction-v0"
 
@@ -66,7 +75,8 @@ def bench_vector(n_envs: int, n_steps: int, mode: str = "async", seed: int = 0):
     return total / wall, total * dt / wall
 
 
-CASES = ("rl", "vec-sync-2", "vec-async-2", "vec-sync-4", "vec-async-4", "paper")
+CASES = ("rl", "vec-sync-2", "vec-async-2", "vec-sync-4", "vec-async-4", "paper",
+         "paper-core0")
 
 
 def run_case(case: str, a) -> tuple:
@@ -74,9 +84,17 @@ def run_case(case: str, a) -> tuple:
     if case == "rl":
         sps, rtf, tr = bench_single("rl", a.rl_steps)
         return ("rl (modal ROM, 3 modes)", "1 process", a.rl_steps, sps, rtf, f"{tr * 1e3:.1f} ms")
+    if case == "paper-core0":           # the same in a child process pinned to core 0
+        out = subprocess.run(
+            [sys.executable, os.path.abspath(__file__), "--only", "paper", "--paper-steps",
+             str(a.paper_steps)], capture_output=True, text=True, check=True,
+            preexec_fn=lambda: os.sched_setaffinity(0, {0}))
+        row = ast.literal_eval(out.stdout.strip().splitlines()[-1])
+        return (row[0] + ", pinned to core 0", *row[1:])
     if case == "paper":
         sps, rtf, tr = bench_single("paper", a.paper_steps)
-        return ("paper (full model, n_nodes 3)", "1 process", a.paper_steps, sps, rtf, f"{tr:.0f} s")
+        return ("paper (full model, n_nodes 3, frictionless)", "1 process", a.paper_steps, sps,
+                rtf, f"{tr:.2f} s")
     _, mode, n = case.split("-")
     n = int(n)
     sps, rtf = bench_vector(n, a.vec_steps, mode)
@@ -88,10 +106,9 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--rl-steps", type=int, default=6000)
     ap.add_argument("--vec-steps", type=int, default=2000, help="batch steps per vector case")
-    ap.add_argument("--paper-steps", type=int, default=20)
+    ap.add_argument("--paper-steps", type=int, default=100)
     ap.add_argument("--only", choices=CASES, help="run this case only; print, write nothing")
-    ap.add_argument("--machine-state", default="side by side with other work",
-                    help="the table's note on the machine's load")
+    ap.add_argument("--out", default=OUT)
     a = ap.parse_args()
     for name in ("rl_steps", "vec_steps", "paper_steps"):
         if getattr(a, name) < 1:
@@ -99,18 +116,18 @@ def main():
     if a.only:
         print(run_case(a.only, a))
         return
-    load0 = os.getloadavg()[0]
+    cpu0, load0 = cpu_times(), os.getloadavg()
     rows = []
     for case in CASES:
         rows.append(run_case(case, a))
         print(rows[-1])
-    load1 = os.getloadavg()[0]
-    lines = ["# boom_env speed (benchmarks/env_speed.py)", "",
-             f"Machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
-             f"{a.machine_state} (1-minute load average {load0:.1f} before, {load1:.1f} after); "
-             f"Python {platform.python_version()}, gymnasium {gym.__version__}.  Control step "
-             "dt = 0.05 s, random actions.  Real-time factor = simulated time / wall time.", "",
-             "| case | workers | env steps | env steps/s | real-time factor | reset |",
+    cpu1, load1 = cpu_times(), os.getloadavg()
+    lines = ["# boom_env speed", "",
+             "Written by `benchmarks/env_speed.py` (its docstring describes the cases).  Control "
+             "step dt = 0.05 s, random actions; real-time factor = simulated time / wall time; "
+             f"gymnasium {gym.__version__}.", "", "Machine:", "",
+             *machine_lines(cpu0, cpu1, load0, load1), "",
+             "| case | workers | env steps | env steps/s | real-time factor | first reset |",
              "| --- | --- | --- | --- | --- | --- |"]
     for name, w, n, sps, rtf, tr in rows:
         lines.append(f"| {name} | {w} | {n} | {sps:.1f} | {rtf:.3g} | {tr} |")
@@ -119,17 +136,10 @@ def main():
     for n in (2, 4):
         sync, asyn = (by[f"rl, gym.make_vec {m}, {n} envs"] for m in ("sync", "async"))
         ratios.append(f"{n} envs {sync / asyn:.2f}")
-    lines += ["", "The `paper` row is an estimate from a few control steps after the reset "
-              "(the reset solves the static equilibrium of the full model).  "
-              f"Vector envs, sync / async steps per second: {', '.join(ratios)}.", ""]
-    out = Path(__file__).with_name("env_speed.md")
-    notes = ""
-    if out.exists():                      # hand-written notes below "## Notes" are kept
-        old = out.read_text()
-        if "\n## Notes" in old:
-            notes = old[old.index("\n## Notes") + 1:]
-    out.write_text("\n".join(lines) + "\n" + notes)
-    print(out.read_text())
+    lines += ["", "The `paper` row's reset solves the static equilibrium of the full model; its "
+              "steps are timed after it.  Vector envs, sync / async steps per second: "
+              f"{', '.join(ratios)}.", ""]
+    write_markdown(a.out, lines)
 
 
 if __name__ == "__main__":

@@ -25,14 +25,15 @@ Dynamics (``fidelity``)
 * ``"rl"`` (default): the stroke-parametric modal reduced-order model
   ``sim_core.systems.telescopic.modal`` (in-plane modes of the full sim_core model, linearised about the
   static equilibrium at each L_s; tables shipped in sim_core/systems/telescopic/data).  ~2e4 env steps/s on one
-  core, ~900 times real time (benchmarks/env_speed.md).
+  core, ~1000 times real time (benchmarks/results/env_speed.md).
 * ``"paper"``: the full sim_core model (``sim_core.systems.telescopic.build``, frictionless by default,
   ``paper_n_nodes`` nodes per spline element, default 3; ``booms`` sections, synchronized
   drive) advanced step by step: for each control step the targets of the telescopic cylinders
   (every cylinder of the synchronized drive) are replaced by the env's stroke kinematics and
   the model is integrated with ``sim_core.integrate.driver.integrate`` (rtol 1e-6, atol 1e-7) from
-  the current state.  Slow: a real-time factor of order 1 or less (benchmarks/env_speed.md);
-  for checking policies, not for training.
+  the current state.  Slow: ~50 env steps/s, a real-time factor of ~2.4 on one core at the
+  default 3 nodes, and a reset of ~0.3 s (benchmarks/results/env_speed.md); for checking
+  policies, not for training.
 
 Stroke kinematics (both fidelities)
 -----------------------------------
