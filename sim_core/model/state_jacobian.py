@@ -33,6 +33,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from sim_core.physics._constraints_numba import program_for
+from sim_core.physics._rigid_body_numba import joint_program_for
 from sim_core.physics.complex_step import COMPLEX_STEP
 from sim_core.physics.constraints import constraint_terms, targets
 
@@ -219,7 +220,8 @@ def residual_derivatives(model, t: float, Q: np.ndarray, Qd: np.ndarray, Qdd: np
     # part of the complex-step Jacobian G(Q + i h Q_dot) / h
     xi1, xi2 = model.baumgarte
     row = 0
-    prog = program_for(model.nonlinear) if COMPILED_CONSTRAINT_COLUMNS else None
+    prog = ((program_for(model.nonlinear) or joint_program_for(model.nonlinear))
+            if COMPILED_CONSTRAINT_COLUMNS else None)
     G = None                               # g_Q at (Q, Q_dot), where the sweep forms it
     if prog is not None:        # all constraint pieces in one compiled sweep (same differences)
         b0, bd, bdd = targets(model.nonlinear, t)

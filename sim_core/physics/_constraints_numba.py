@@ -444,6 +444,8 @@ def _build(cons):
             s = getattr(f, "spec", None)
             if s is None:
                 return None
+            if s[0] not in ("material", "fixed"):     # a rigid frame: _rigid_body_numba
+                return None
             if s[0] == "material":
                 if model is None:
                     model = s[1]

@@ -12,6 +12,27 @@ The kinematics of the module docstring of :mod:`sim_core.physics.rigid_body`:
 
 for the turntable (no body coordinates) r = S p, R = S and only the phi columns.  Real or
 complex-step states (the complex step carries d/dQ . Q_dot through every line).
+
+The joint rows of the folding manipulator as one compiled program (:class:`JointProgram`, the
+reference is the Python closures of :mod:`sim_core.physics.rigid_body` and
+:mod:`sim_core.physics.constraints`; ``tests/folding/test_joint_program.py`` compares both).
+Every frame once at the complex-step state Q + i h Q_dot (h = 1e-20) on its own columns: a
+planar body or the turntable as above, a boom's cross-section frame at a fixed material point
+(:func:`sim_core.physics.rigid_body.beam_frame`: the compiled point kernel's r, J_r, J_psi and
+section frame, W = [e_s e_t e_b] T J_psi, a rigid offset o = R p with J += [o]x^T W).  Then
+each constraint's rows from its frames (complex):
+
+* coincidence  g = r_a - r_b,  G = J_a - J_b                      (constraints.point_coincidence)
+* distance     g = |d|, d = r_a - r_b,  G = (d / |d|) (J_a - J_b)  (constraints.distance_driver)
+* hinge axis   g = u . n, u = R_b w (w = p_b, q_b), n = R_a c_a,
+               G = (u x n) . (W_b - W_a)                          (rigid_body.revolute_axis)
+* planar pin   g_k = E_k . d, E = R_plane[:, :2], d = r_a - r_b,
+               G_k = E_k . (J_a - J_b) + (E_k x d) . W_plane      (rigid_body.planar_pin)
+* prismatic    g = d . e, e = R_a m_a, d = r_b - r_a,
+               G = e . (J_b - J_a) + (e x d) . W_a                (rigid_body.prismatic_offset)
+
+The value and G = g_Q are the real parts; the quadratic velocity term g_QQ[Q_dot, Q_dot] =
+Im(G(Q + i h Q_dot) Q_dot) / h, as :func:`sim_core.physics.constraints.constraint_terms`.
 """
 
 from __future__ import annotations
@@ -19,6 +40,12 @@ from __future__ import annotations
 import numpy as np
 
 from sim_core._numba import AVAILABLE, numba
+from sim_core.physics.beam import _cardan_numba as cardan_compiled
+from sim_core.physics.beam import _moving_node_beam_numba as point_compiled
+from sim_core.physics.complex_step import COMPLEX_STEP
+
+PLANAR, BEAM = 0, 1                                   # frame kinds
+COINCIDENCE, DISTANCE, HINGE_AXIS, PLANAR_PIN, PRISMATIC = 0, 1, 2, 3, 4   # row kinds
 
 
 def _planar_frame(Q, i_phi, iu, iv, it, C0, S0, P0, ax, p, r, J, R, W):
@@ -59,8 +86,415 @@ def _planar_frame(Q, i_phi, iu, iv, it, C0, S0, P0, ax, p, r, J, R, W):
         W[i, i_phi] = ax[i]
 
 
+def _frame_local(f, Qc, f_kind, f_idx, f_C, f_ax, f_p, f_s, f_hasoff, el_idx, n, D_all,
+                 pow_p, pow_t, bases, i_s1, Rf, Jf, Rot, Wf, FC, FN):
+    """Frame f at the complex state Qc into Rf[f] (3,), Rot[f] (3, 3), and Jf[f], Wf[f] (3, L)
+    on its columns FC[f, :FN[f]]; returns the finite-check sum."""
+    if f_kind[f] == PLANAR:
+        i_phi, iu, iv, it = f_idx[f, 0], f_idx[f, 1], f_idx[f, 2], f_idx[f, 3]
+        phi = Qc[i_phi]
+        c = np.cos(phi)
+        s = np.sin(phi)
+        for i in range(3):
+            for k in range(3):
+                Rot[f, i, k] = c * f_C[f, 0, i, k] + s * f_C[f, 1, i, k] + f_C[f, 2, i, k]
+        p = f_p[f]
+        ax = f_ax[f]
+        for i in range(3):
+            for k in range(4):
+                Jf[f, i, k] = 0.0
+                Wf[f, i, k] = 0.0
+        FC[f, 0] = i_phi
+        if iu >= 0:
+            FC[f, 1] = iu
+            FC[f, 2] = iv
+            FC[f, 3] = it
+            FN[f] = 4
+            th = Qc[it]
+            ct = np.cos(th)
+            st = np.sin(th)
+            a0 = Qc[iu] + (ct * p[0] - st * p[1])
+            a1 = Qc[iv] + (st * p[0] + ct * p[1])
+            d0 = -st * p[0] - ct * p[1]
+            d1 = ct * p[0] - st * p[1]
+            for i in range(3):
+                eu = Rot[f, i, 0]
+                ev = Rot[f, i, 1]
+                nn = Rot[f, i, 2]
+                Rf[f, i] = a0 * eu + a1 * ev + p[2] * nn
+                Jf[f, i, 1] = eu
+                Jf[f, i, 2] = ev
+                Jf[f, i, 3] = d0 * eu + d1 * ev
+                Wf[f, i, 3] = nn
+                Rot[f, i, 0] = ct * eu + st * ev
+                Rot[f, i, 1] = ct * ev - st * eu
+        else:
+            FN[f] = 1
+            for i in range(3):
+                Rf[f, i] = Rot[f, i, 0] * p[0] + Rot[f, i, 1] * p[1] + Rot[f, i, 2] * p[2]
+        r = Rf[f]
+        Jf[f, 0, 0] = ax[1] * r[2] - ax[2] * r[1]
+        Jf[f, 1, 0] = ax[2] * r[0] - ax[0] * r[2]
+        Jf[f, 2, 0] = ax[0] * r[1] - ax[1] * r[0]
+        for i in range(3):
+            Wf[f, i, 0] = ax[i]
+        return 0.0
+    # BEAM: the section frame of element f_idx[f, 0] at the material point f_s[f]
+    e = f_idx[f, 0]
+    idx = el_idx[e]
+    nq = idx.shape[0]
+    qe = np.empty(nq, dtype=np.complex128)
+    for k in range(nq):
+        qe[k] = Qc[idx[k]]
+        FC[f, k] = idx[k]
+    FN[f] = nq
+    r, _, J_r, J_psi, _, _, frame, tmat, total = _point(qe, f_s[f] + 0.0j, n, D_all, pow_p,
+                                                         pow_t, bases[e], i_s1)
+    A = np.empty((3, 3), dtype=np.complex128)       # [e_s e_t e_b] tmat (frame rows t, b, s)
+    for i in range(3):
+        for j in range(3):
+            A[i, j] = frame[2, i] * tmat[0, j] + frame[0, i] * tmat[1, j] \
+                + frame[1, i] * tmat[2, j]
+    for i in range(3):
+        for k in range(nq):
+            Wf[f, i, k] = A[i, 0] * J_psi[0, k] + A[i, 1] * J_psi[1, k] + A[i, 2] * J_psi[2, k]
+            Jf[f, i, k] = J_r[i, k]
+        for k in range(3):
+            Rot[f, i, k] = frame[k, i]                 # R = frame^T: columns e_t, e_b, e_s
+        Rf[f, i] = r[i]
+    if f_hasoff[f]:
+        p = f_p[f]
+        o = np.empty(3, dtype=np.complex128)
+        for i in range(3):
+            o[i] = Rot[f, i, 0] * p[0] + Rot[f, i, 1] * p[1] + Rot[f, i, 2] * p[2]
+        for k in range(nq):                            # J += [[0, o2, -o1], [-o2, 0, o0],
+            w0 = Wf[f, 0, k]                           #       [o1, -o0, 0]] W
+            w1 = Wf[f, 1, k]
+            w2 = Wf[f, 2, k]
+            Jf[f, 0, k] += o[2] * w1 - o[1] * w2
+            Jf[f, 1, k] += o[0] * w2 - o[2] * w0
+            Jf[f, 2, k] += o[1] * w0 - o[0] * w1
+        for i in range(3):
+            Rf[f, i] += o[i]
+    return total
+
+
+def _add_row(Gc, row, f, coef, X, FC, FN):
+    """Gc[row, FC[f, k]] += coef . X[f, :, k] (coef (3,) complex, X = Jf or Wf)."""
+    for k in range(FN[f]):
+        Gc[row, FC[f, k]] += coef[0] * X[f, 0, k] + coef[1] * X[f, 1, k] + coef[2] * X[f, 2, k]
+
+
+def _cross(a, b, out):
+    out[0] = a[1] * b[2] - a[2] * b[1]
+    out[1] = a[2] * b[0] - a[0] * b[2]
+    out[2] = a[0] * b[1] - a[1] * b[0]
+
+
+def _joint_terms(Q, Qd, N, f_kind, f_idx, f_C, f_ax, f_p, f_s, f_hasoff, el_idx, n, D_all,
+                 pow_p, pow_t, bases, i_s1, c_kind, c_f, c_vec, c_row0, m, cstep, rate_part):
+    """(g (m,), G (m, N), g_QQ[Q_dot, Q_dot] (m,), g_QQ Q_dot (m, N) or (0, 0), finite-check
+    sum) of the joint rows at the real state (Q, Q_dot); see the module docstring."""
+    Qc = np.empty(N, dtype=np.complex128)
+    for k in range(N):
+        Qc[k] = Q[k] + 1j * (cstep * Qd[k])
+    F = f_kind.shape[0]
+    L = max(el_idx.shape[1], 4)
+    Rf = np.empty((F, 3), dtype=np.complex128)
+    Rot = np.empty((F, 3, 3), dtype=np.complex128)
+    Jf = np.zeros((F, 3, L), dtype=np.complex128)
+    Wf = np.zeros((F, 3, L), dtype=np.complex128)
+    FC = np.zeros((F, L), dtype=np.int64)
+    FN = np.zeros(F, dtype=np.int64)
+    total = 0.0
+    for f in range(F):
+        total += _frame_local(f, Qc, f_kind, f_idx, f_C, f_ax, f_p, f_s, f_hasoff, el_idx, n,
+                              D_all, pow_p, pow_t, bases, i_s1, Rf, Jf, Rot, Wf, FC, FN)
+    gc = np.zeros(m, dtype=np.complex128)
+    Gc = np.zeros((m, N), dtype=np.complex128)
+    d = np.empty(3, dtype=np.complex128)
+    u = np.empty(3, dtype=np.complex128)
+    v = np.empty(3, dtype=np.complex128)
+    x = np.empty(3, dtype=np.complex128)
+    w = np.empty(3, dtype=np.complex128)
+    for c in range(c_kind.shape[0]):
+        kind = c_kind[c]
+        a, b, pl = c_f[c, 0], c_f[c, 1], c_f[c, 2]
+        r0 = c_row0[c]
+        if kind == COINCIDENCE or kind == DISTANCE or kind == PLANAR_PIN:
+            for i in range(3):
+                d[i] = Rf[a, i] - Rf[b, i]
+        if kind == COINCIDENCE:
+            for i in range(3):
+                gc[r0 + i] = d[i]
+                for k in range(FN[a]):
+                    Gc[r0 + i, FC[a, k]] += Jf[a, i, k]
+                for k in range(FN[b]):
+                    Gc[r0 + i, FC[b, k]] -= Jf[b, i, k]
+        elif kind == DISTANCE:
+            nn = np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+            gc[r0] = nn
+            for i in range(3):
+                u[i] = d[i] / nn
+            _add_row(Gc, r0, a, u, Jf, FC, FN)
+            for i in range(3):
+                u[i] = -u[i]
+            _add_row(Gc, r0, b, u, Jf, FC, FN)
+        elif kind == HINGE_AXIS:
+            for i in range(3):                         # n = R_a c_a
+                v[i] = Rot[a, i, 0] * c_vec[c, 0, 0] + Rot[a, i, 1] * c_vec[c, 0, 1] \
+                    + Rot[a, i, 2] * c_vec[c, 0, 2]
+            for q in range(2):
+                for i in range(3):                     # u = R_b w
+                    u[i] = Rot[b, i, 0] * c_vec[c, 1 + q, 0] + Rot[b, i, 1] * c_vec[c, 1 + q, 1] \
+                        + Rot[b, i, 2] * c_vec[c, 1 + q, 2]
+                gc[r0 + q] = u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
+                _cross(u, v, x)
+                _add_row(Gc, r0 + q, b, x, Wf, FC, FN)
+                for i in range(3):
+                    x[i] = -x[i]
+                _add_row(Gc, r0 + q, a, x, Wf, FC, FN)
+        elif kind == PLANAR_PIN:
+            for q in range(2):
+                for i in range(3):
+                    w[i] = Rot[pl, i, q]                # E_q
+                gc[r0 + q] = w[0] * d[0] + w[1] * d[1] + w[2] * d[2]
+                _add_row(Gc, r0 + q, a, w, Jf, FC, FN)
+                for i in range(3):
+                    u[i] = -w[i]
+                _add_row(Gc, r0 + q, b, u, Jf, FC, FN)
+                _cross(w, d, x)
+                _add_row(Gc, r0 + q, pl, x, Wf, FC, FN)
+        else:                                          # PRISMATIC
+            for i in range(3):                         # e = R_a m_a, d = r_b - r_a
+                w[i] = Rot[a, i, 0] * c_vec[c, 0, 0] + Rot[a, i, 1] * c_vec[c, 0, 1] \
+                    + Rot[a, i, 2] * c_vec[c, 0, 2]
+                d[i] = Rf[b, i] - Rf[a, i]
+            gc[r0] = w[0] * d[0] + w[1] * d[1] + w[2] * d[2]
+            _add_row(Gc, r0, b, w, Jf, FC, FN)
+            for i in range(3):
+                u[i] = -w[i]
+            _add_row(Gc, r0, a, u, Jf, FC, FN)
+            _cross(w, d, x)
+            _add_row(Gc, r0, a, x, Wf, FC, FN)
+    g = np.empty(m)
+    G = np.empty((m, N))
+    quad = np.empty(m)
+    Gr = np.empty((m, N) if rate_part else (0, 0))
+    for i in range(m):
+        g[i] = gc[i].real
+        acc = 0.0j
+        for k in range(N):
+            acc += Gc[i, k] * Qd[k]
+            G[i, k] = Gc[i, k].real
+            if rate_part:
+                Gr[i, k] = Gc[i, k].imag / cstep
+        quad[i] = acc.imag / cstep
+        total += g[i] + quad[i]
+    return g, G, quad, Gr, total
+
+
+def _joint_columns(Q, Qd, Qdd, lam, b0, bd, bdd, xi1, xi2, cols, steps, N, f_kind, f_idx,
+                   f_C, f_ax, f_p, f_s, f_hasoff, el_idx, n, D_all, pow_p, pow_t, bases, i_s1,
+                   c_kind, c_f, c_vec, c_row0, m, cstep):
+    """Forward-difference columns j in ``cols`` (steps ``steps``) of r1 = G^T lambda (N,) and
+    r2 = G Q_ddot - (b_ddot - g_QQ[Q_dot, Q_dot] - 2 xi1 (G Q_dot - b_dot) - xi2^2 (g - b))
+    (m,), the Python constraint pieces' formulas of sim_core.model.state_jacobian:
+    (dR1 (N, ncols), dR2 (m, ncols), finite-check sum).  Every column re-evaluates all frames
+    and rows (~35 us at the folding manipulator's 18 frames and 30 rows)."""
+    args = (N, f_kind, f_idx, f_C, f_ax, f_p, f_s, f_hasoff, el_idx, n, D_all, pow_p, pow_t,
+            bases, i_s1, c_kind, c_f, c_vec, c_row0, m, cstep, False)
+    g0, G0, q0, _, total = _joint_terms_compiled(Q, Qd, *args)
+    r2_0 = np.empty(m)
+    for i in range(m):
+        gq = 0.0
+        gd = 0.0
+        for k in range(N):
+            gq += G0[i, k] * Qdd[k]
+            gd += G0[i, k] * Qd[k]
+        r2_0[i] = gq - (bdd[i] - q0[i] - 2.0 * xi1 * (gd - bd[i]) - xi2 * xi2 * (g0[i] - b0[i]))
+    ncol = cols.shape[0]
+    dR1 = np.zeros((N, ncol))
+    dR2 = np.zeros((m, ncol))
+    Qx = Q.copy()
+    for jj in range(ncol):
+        j = cols[jj]
+        h = steps[jj]
+        x = Q[j]
+        Qx[j] = x + h
+        g1, G1, q1, _, t1 = _joint_terms_compiled(Qx, Qd, *args)
+        Qx[j] = x
+        total += t1
+        for i in range(m):
+            li = lam[i] / h
+            gq = 0.0
+            gd = 0.0
+            for k in range(N):
+                dR1[k, jj] += li * (G1[i, k] - G0[i, k])
+                gq += G1[i, k] * Qdd[k]
+                gd += G1[i, k] * Qd[k]
+            r2 = gq - (bdd[i] - q1[i] - 2.0 * xi1 * (gd - bd[i]) - xi2 * xi2 * (g1[i] - b0[i]))
+            dR2[i, jj] = (r2 - r2_0[i]) / h
+    return dR1, dR2, total
+
+
 if AVAILABLE:
     _planar_frame = numba.njit(cache=True, nogil=True)(_planar_frame)
+    _point = point_compiled.compiled_point
+    _jit = numba.njit(cache=True, nogil=True)
+    _frame_local = _jit(_frame_local)
+    _add_row = _jit(_add_row)
+    _cross = _jit(_cross)
+    _joint_terms_compiled = _jit(_joint_terms)
+    _joint_columns_compiled = _jit(_joint_columns)
+
+
+_KINDS = {"coincidence": COINCIDENCE, "distance": DISTANCE, "hinge_axis": HINGE_AXIS,
+          "planar_pin": PLANAR_PIN, "prismatic": PRISMATIC}
+
+
+class JointProgram:
+    """The frame and row tables of a joint list (see the module docstring); build with
+    :func:`joint_program_for`."""
+
+    def __init__(self, model, frames, cons):
+        els = [el for b in model.beams for el in b.elements]
+        el0 = els[0]
+        self.N = int(model.n_coords)
+        self.n, self.i_s1 = int(el0.n), int(el0.i_s1)
+        self.D_all = np.ascontiguousarray(el0.D_all, dtype=float)
+        self.pow_p = np.ascontiguousarray(el0.pow_p)
+        self.pow_t = np.ascontiguousarray(el0.pow_t)
+        self.bases = np.ascontiguousarray(np.stack([el.G for el in els]), dtype=float)
+        self.el_idx = np.stack([np.asarray(off + imap, dtype=np.int64)
+                                for b, off in zip(model.beams, model.offsets)
+                                for imap in b.index_map])
+        first = np.cumsum([0] + [len(b.elements) for b in model.beams])
+        F = len(frames)
+        self.frames = frames
+        self.f_kind = np.zeros(F, dtype=np.int64)
+        self.f_idx = np.full((F, 4), -1, dtype=np.int64)
+        self.f_C = np.zeros((F, 3, 3, 3))
+        self.f_ax = np.zeros((F, 3))
+        self.f_p = np.zeros((F, 3))
+        self.f_s = np.zeros(F)
+        self.f_hasoff = np.zeros(F, dtype=np.bool_)
+        for i, f in enumerate(frames):
+            spec = f.spec
+            if spec[0] == "planar":
+                _, cols, C0, S0, P0, ax, p = spec
+                self.f_kind[i] = PLANAR
+                self.f_idx[i] = cols
+                self.f_C[i] = (C0, S0, P0)
+                self.f_ax[i] = ax
+                self.f_p[i] = p
+            else:                                    # ("beam", model, ibeam, s, p or None)
+                _, _, ibeam, s, p = spec
+                self.f_kind[i] = BEAM
+                self.f_idx[i, 0] = first[ibeam]
+                self.f_s[i] = s
+                if p is not None:
+                    self.f_p[i] = p
+                    self.f_hasoff[i] = True
+        where = {id(f): i for i, f in enumerate(frames)}
+        K = len(cons)
+        self.m = int(sum(c.m for c in cons))
+        self.c_kind = np.zeros(K, dtype=np.int64)
+        self.c_f = np.full((K, 3), -1, dtype=np.int64)
+        self.c_vec = np.zeros((K, 3, 3))
+        self.c_row0 = np.zeros(K, dtype=np.int64)
+        row = 0
+        for k, c in enumerate(cons):
+            kind, vecs, fs = c.joint_program
+            self.c_kind[k] = _KINDS[kind]
+            self.c_f[k, :len(fs)] = [where[id(f)] for f in fs]
+            for j, vec in enumerate(vecs):
+                self.c_vec[k, j] = vec
+            self.c_row0[k] = row
+            row += c.m
+
+    def terms(self, Q, Qd, rate_part: bool = False):
+        """(g (m,) without the targets b, G = g_Q (m, N), g_QQ[Q_dot, Q_dot] (m,), and with
+        ``rate_part`` g_QQ Q_dot (m, N), else None) at the real state (Q, Q_dot); the interface
+        of :meth:`sim_core.physics._constraints_numba.ConstraintProgram.terms`."""
+        Q = np.ascontiguousarray(Q, dtype=float)
+        Qd = np.ascontiguousarray(Qd, dtype=float)
+        g, G, quad, Gr, total = _joint_terms_compiled(Q, Qd, *self._args(), bool(rate_part))
+        cardan_compiled.check_finite(total, "joint rows")
+        return g, G, quad, (Gr if rate_part else None)
+
+    def _args(self):
+        return (self.N, self.f_kind, self.f_idx, self.f_C, self.f_ax, self.f_p, self.f_s,
+                self.f_hasoff, self.el_idx, self.n, self.D_all, self.pow_p, self.pow_t,
+                self.bases, self.i_s1, self.c_kind, self.c_f, self.c_vec, self.c_row0, self.m,
+                COMPLEX_STEP)
+
+    def dependencies(self, Q) -> np.ndarray:
+        """(F, N) bool: the coordinates each frame depends on at Q (its ``coords``)."""
+        deps = np.zeros((len(self.frames), self.N), dtype=np.bool_)
+        for i, f in enumerate(self.frames):
+            deps[i, f.coords(Q)] = True
+        return deps
+
+    def columns(self, Q, Qd, Qdd, lam, b0, bd, bdd, xi1, xi2, cols, steps, deps=None):
+        """Forward-difference columns ``cols`` (steps ``steps``) of G^T lambda (N, ncols) and of
+        the acceleration-level rows (m, ncols), see _joint_columns; the interface of
+        :meth:`sim_core.physics._constraints_numba.ConstraintProgram.columns` (``deps`` unused:
+        every column re-evaluates all frames)."""
+        f = np.ascontiguousarray
+        dR1, dR2, total = _joint_columns_compiled(
+            f(Q, dtype=float), f(Qd, dtype=float), f(Qdd, dtype=float), f(lam, dtype=float),
+            f(b0, dtype=float), f(bd, dtype=float), f(bdd, dtype=float), float(xi1),
+            float(xi2), f(cols, dtype=np.int64), f(steps, dtype=float), *self._args())
+        cardan_compiled.check_finite(total, "joint rows")
+        return dR1, dR2
+
+
+def joint_program_for(cons) -> JointProgram | None:
+    """The compiled program of a joint list (cached on its first constraint, rebuilt when the
+    list changes), or None where it does not cover the list: numba missing, a constraint
+    without ``joint_program``, a frame without a planar or beam ``spec``, frames of more than one
+    model, a beam of more than one element, or elements with unequal tables."""
+    if not AVAILABLE or not cons:
+        return None
+    key = tuple(id(c) for c in cons)
+    hit = cons[0].__dict__.get("_joint_program")
+    if hit is not None and hit[0] == key:
+        return hit[1]
+    prog = _build(cons)
+    cons[0].__dict__["_joint_program"] = (key, prog)
+    return prog
+
+
+def _build(cons):
+    frames, seen, model = [], set(), None
+    for c in cons:
+        spec = getattr(c, "joint_program", None)
+        if spec is None:
+            return None
+        for f in spec[2]:
+            s = getattr(f, "spec", None)
+            if s is None or s[0] not in ("planar", "beam"):
+                return None
+            if s[0] == "beam":
+                if model is None:
+                    model = s[1]
+                elif s[1] is not model:
+                    return None
+            if id(f) not in seen:
+                seen.add(id(f))
+                frames.append(f)
+    if model is None or any(len(b.elements) != 1 for b in model.beams):
+        return None
+    els = [el for b in model.beams for el in b.elements]
+    el0 = els[0]
+    for el in els:
+        if (el.n != el0.n or el.i_s1 != el0.i_s1 or len(el.G) != 3
+                or not np.array_equal(el.D_all, el0.D_all)
+                or not np.array_equal(el.pow_p, el0.pow_p)
+                or not np.array_equal(el.pow_t, el0.pow_t)):
+            return None
+    return JointProgram(model, frames, cons)
 
 
 def planar_frame(Q, n_coords, i_phi, iu, iv, it, C0, S0, P0, ax, p):

@@ -24,6 +24,7 @@ from typing import Callable
 import numpy as np
 
 from sim_core.physics import _constraints_numba as constraint_compiled
+from sim_core.physics import _rigid_body_numba as joint_compiled
 from sim_core.physics._constraints_numba import DIFF_PSI, DIFF_R, DISTANCE, ROPE
 from sim_core.physics.beam import _moving_node_beam_numba as point_compiled
 from sim_core.physics.complex_step import COMPLEX_STEP
@@ -50,6 +51,10 @@ class NonlinearConstraint:
     # (kind, components, point functions) of sim_core.physics._constraints_numba, set by the factories
     # below: the rows as one compiled program (None: this constraint is evaluated in Python)
     program: tuple | None = None
+    # (kind, vectors, frame functions) of the compiled joint rows of
+    # sim_core.physics._rigid_body_numba (rigid frames: hinges, pins, prismatic joints), set by
+    # the factories; None: not a joint row of that program
+    joint_program: tuple | None = None
 
     def coords(self, Q: Vec) -> np.ndarray | None:
         """Coordinates g depends on at Q (None: possibly all)."""
@@ -97,7 +102,7 @@ def constraint_terms(cons: list[NonlinearConstraint], t: float, Q: Vec, Qd: Vec)
         return e, np.zeros((0, len(Q))), e, e
     real = not (np.iscomplexobj(Q) or np.iscomplexobj(Qd))
     if real and COMPILED_ROWS:
-        prog = constraint_compiled.program_for(cons)
+        prog = constraint_compiled.program_for(cons) or joint_compiled.joint_program_for(cons)
         if prog is not None:
             g, G, quad, _ = prog.terms(Q, Qd)
             b, bd, bdd = targets(cons, t)
@@ -302,7 +307,9 @@ def _coincidence(name: str, fa, fb, fixed, part: int) -> NonlinearConstraint:
     pts = (fa,) if fb is None else (fa, fb)
     return NonlinearConstraint(name, 3, evaluate, None if fixed is None else _fixed(fixed),
                                points=pts,
-                               program=(DIFF_PSI if part else DIFF_R, (0, 1, 2), pts))
+                               program=(DIFF_PSI if part else DIFF_R, (0, 1, 2), pts),
+                               joint_program=None if part or fb is None else
+                               ("coincidence", (), pts))
 
 
 def point_coincidence(name: str, fa, fb=None, fixed=None) -> NonlinearConstraint:
@@ -327,7 +334,8 @@ def distance_driver(name: str, fa, fb, length) -> NonlinearConstraint:
         n = np.sqrt(d @ d)
         return np.atleast_1d(n), ((d / n) @ (Ja - Jb))[None, :]
     return NonlinearConstraint(name, 1, evaluate, length, points=(fa, fb),
-                               program=(DISTANCE, (), (fa, fb)))
+                               program=(DISTANCE, (), (fa, fb)),
+                               joint_program=("distance", (), (fa, fb)))
 
 
 def rope_length(name: str, points, length: float) -> NonlinearConstraint:

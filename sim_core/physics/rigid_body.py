@@ -147,7 +147,9 @@ def turntable_frame(n_coords: int, i_phi: int, slew_axis, plane_basis, point=(0.
         J[:, i_phi] = _cross_axis(ax, r)
         W[:, i_phi] = ax
         return r, J, R, W
-    return _memo(fun, lambda Q: cols)
+    f = _memo(fun, lambda Q: cols)
+    f.spec = ("planar", (i_phi, -1, -1, -1), C0, S0, P0, ax, p)    # joint_compiled
+    return f
 
 
 def planar_body_frame(n_coords: int, i_phi: int, i_body: int, slew_axis, plane_basis,
@@ -187,7 +189,9 @@ def planar_body_frame(n_coords: int, i_phi: int, i_body: int, slew_axis, plane_b
         R[:, 1] = c * e_v - s * e_u
         R[:, 2] = n
         return r, J, R, W
-    return _memo(fun, lambda Q: cols)
+    f = _memo(fun, lambda Q: cols)
+    f.spec = ("planar", (i_phi, iu, iv, it), C0, S0, P0, ax, p)     # joint_compiled
+    return f
 
 
 def beam_frame(model, ibeam: int, s: float, point_global_offset=None, frame0=None):
@@ -242,7 +246,9 @@ def beam_frame(model, ibeam: int, s: float, point_global_offset=None, frame0=Non
         J[:, idx] = J_r
         W[:, idx] = Wl
         return r, J, R, W
-    return _memo(fun, cols)
+    f = _memo(fun, cols)
+    f.spec = ("beam", model, ibeam, float(s), p)                   # joint_compiled
+    return f
 
 
 # -- rigid body inertia ------------------------------------------------------------------------
@@ -397,7 +403,8 @@ def planar_pin(name: str, fa, fb, plane_frame) -> NonlinearConstraint:
         # dE/dQ_j = W_j x E  ->  d/dQ_j (E_k . d) = (W_j x E_k) . d = W_j . (E_k x d)
         J = E.T @ (Ja - Jb) + np.stack([_cross3(E[:, k], d) @ W for k in range(2)])
         return g, J
-    return NonlinearConstraint(name, 2, evaluate, points=(fa, fb, plane_frame))
+    return NonlinearConstraint(name, 2, evaluate, points=(fa, fb, plane_frame),
+                               joint_program=("planar_pin", (), (fa, fb, plane_frame)))
 
 
 def revolute_axis(name: str, fa, fb, c_a, p_b, q_b) -> NonlinearConstraint:
@@ -416,7 +423,8 @@ def revolute_axis(name: str, fa, fb, c_a, p_b, q_b) -> NonlinearConstraint:
             g.append(u @ n)
             J.append(_cross3(u, n) @ (Wb - Wa))
         return np.array(g), np.vstack(J)
-    return NonlinearConstraint(name, 2, evaluate, points=(fa, fb))
+    return NonlinearConstraint(name, 2, evaluate, points=(fa, fb),
+                               joint_program=("hinge_axis", (c_a, p_b, q_b), (fa, fb)))
 
 
 def prismatic_offset(name: str, fa, fb, axis_normal_a) -> NonlinearConstraint:
@@ -430,4 +438,5 @@ def prismatic_offset(name: str, fa, fb, axis_normal_a) -> NonlinearConstraint:
         e = Ra @ m_a
         d = rb - ra
         return np.atleast_1d(d @ e), (e @ (Jb - Ja) + _cross3(e, d) @ Wa)[None, :]
-    return NonlinearConstraint(name, 1, evaluate, points=(fa, fb))
+    return NonlinearConstraint(name, 1, evaluate, points=(fa, fb),
+                               joint_program=("prismatic", (m_a,), (fa, fb)))

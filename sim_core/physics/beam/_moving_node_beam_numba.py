@@ -152,6 +152,7 @@ def _point_full(Q, idx, s_index, s, o_sec, N, n, D_all, pow_p, pow_t, basis, i_s
 if AVAILABLE:
     _compiled_point = numba.njit(cache=True, nogil=True)(_point)
     _point = _compiled_point                   # the callee of _point_local
+    compiled_point = _compiled_point           # the callee of _rigid_body_numba's beam frames
     compiled_point_local = numba.njit(cache=True, nogil=True)(_point_local)
     _point_local = compiled_point_local       # the callee of _point_full
     _compiled_point_full = numba.njit(cache=True, nogil=True)(_point_full)
