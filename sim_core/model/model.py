@@ -345,7 +345,7 @@ class Model:
         rest = []
         batch = self._compiled_point_effects() if not np.iscomplexobj(Q) \
             and not np.iscomplexobj(Qd) else None
-        local = iter(batch.local(Q, Qd, mass)) if batch is not None else None
+        local = iter(batch.local(Q, Qd, mass, t=t)) if batch is not None else None
         for pe in self.point_effects:
             if hasattr(pe, "local"):
                 idx, Me, Fe = next(local) if local is not None else pe.local(t, Q, Qd, mass)
@@ -371,15 +371,17 @@ class Model:
 
     def _compiled_point_effects(self):
         """The point effects' local blocks from one compiled evaluation
-        (point_effects.CompiledPointEffects) where ``point_effects_compiled`` and it covers
-        them, else None."""
+        (point_effects.CompiledPointEffects: payloads and ropes; rigid_body.CompiledRigidBodies:
+        rigid bodies) where ``point_effects_compiled`` and one covers them, else None."""
         if not self.point_effects_compiled:
             return None
         key = tuple(id(pe) for pe in self.point_effects)
         hit = self.__dict__.get("_pe_batch")
         if hit is None or hit[0] != key:
             from sim_core.physics.point_effects import CompiledPointEffects
-            hit = self._pe_batch = (key, CompiledPointEffects.build(self.point_effects))
+            from sim_core.physics.rigid_body import CompiledRigidBodies
+            hit = self._pe_batch = (key, CompiledPointEffects.build(self.point_effects)
+                                    or CompiledRigidBodies.build(self.point_effects))
         return hit[1]
 
     def _element_blocks_started(self, t, Q, Qd):

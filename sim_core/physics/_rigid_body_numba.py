@@ -32,7 +32,14 @@ each constraint's rows from its frames (complex):
                G = e . (J_b - J_a) + (e x d) . W_a                (rigid_body.prismatic_offset)
 
 The value and G = g_Q are the real parts; the quadratic velocity term g_QQ[Q_dot, Q_dot] =
-Im(G(Q + i h Q_dot) Q_dot) / h, as :func:`sim_core.physics.constraints.constraint_terms`.
+Im(G(Q + i h Q_dot) Q_dot) / h, as :func:`sim_core.physics.constraints.constraint_terms`.  The
+structured Jacobian's constraint columns are forward differences of the same rows
+(:meth:`JointProgram.columns`).
+
+The rigid bodies' Newton-Euler blocks (:class:`BodyProgram`, the formulas of
+:meth:`sim_core.physics.rigid_body.RigidBody.local`) come from their mass-centre frames at the same
+complex-step state in one call: J, W, R the real parts, Jdot Q_dot and Wdot Q_dot the imaginary
+parts of J Q_dot and W Q_dot over h.
 """
 
 from __future__ import annotations
@@ -338,6 +345,91 @@ def _joint_columns(Q, Qd, Qdd, lam, b0, bd, bdd, xi1, xi2, cols, steps, N, f_kin
     return dR1, dR2, total
 
 
+def _body_blocks(Q, Qd, N, f_kind, f_idx, f_C, f_ax, f_p, f_s, f_hasoff, el_idx, n, D_all,
+                 pow_p, pow_t, bases, i_s1, b_mass, b_I, b_g, with_mass, cstep):
+    """Newton-Euler blocks of B rigid bodies whose mass-centre frames are the frames 0..B-1
+    (sim_core.physics.rigid_body.RigidBody.local): on each frame's columns (nc = FN[b])
+        Me = m J^T J + W^T I_g W,  Fe = J^T m (g - Jdot Qd) - W^T (I_g Wdot Qd + w x I_g w),
+    I_g = R I_b R^T, w = W Qd, Jdot Qd and Wdot Qd the imaginary parts of the frame's Jacobians
+    at Q + i h Qd times Qd, over h.  Returns (cols (B, L), ncols (B,), Me (B, L, L), Fe (B, L))."""
+    Qc = np.empty(N, dtype=np.complex128)
+    for k in range(N):
+        Qc[k] = Q[k] + 1j * (cstep * Qd[k])
+    F = f_kind.shape[0]
+    L = max(el_idx.shape[1], 4)
+    Rf = np.empty((F, 3), dtype=np.complex128)
+    Rot = np.empty((F, 3, 3), dtype=np.complex128)
+    Jf = np.zeros((F, 3, L), dtype=np.complex128)
+    Wf = np.zeros((F, 3, L), dtype=np.complex128)
+    FC = np.zeros((F, L), dtype=np.int64)
+    FN = np.zeros(F, dtype=np.int64)
+    B = b_mass.shape[0]
+    Me = np.zeros((B, L, L))
+    Fe = np.zeros((B, L))
+    J = np.empty((3, L))
+    W = np.empty((3, L))
+    R = np.empty((3, 3))
+    Ig = np.empty((3, 3))
+    acc = np.empty(3)
+    wdot = np.empty(3)
+    om = np.empty(3)
+    Iom = np.empty(3)
+    for b in range(B):
+        _frame_local(b, Qc, f_kind, f_idx, f_C, f_ax, f_p, f_s, f_hasoff, el_idx, n, D_all,
+                     pow_p, pow_t, bases, i_s1, Rf, Jf, Rot, Wf, FC, FN)
+        nc = FN[b]
+        m = b_mass[b]
+        for i in range(3):
+            a = 0.0
+            wd = 0.0
+            o = 0.0
+            for k in range(nc):
+                qd = Qd[FC[b, k]]
+                J[i, k] = Jf[b, i, k].real
+                W[i, k] = Wf[b, i, k].real
+                a += Jf[b, i, k].imag * qd
+                wd += Wf[b, i, k].imag * qd
+                o += W[i, k] * qd
+            acc[i] = a / cstep
+            wdot[i] = wd / cstep
+            om[i] = o
+            for j in range(3):
+                R[i, j] = Rot[b, i, j].real
+        for i in range(3):                             # I_g = R I_b R^T
+            for j in range(3):
+                v = 0.0
+                for k in range(3):
+                    for q in range(3):
+                        v += R[i, k] * b_I[b, k, q] * R[j, q]
+                Ig[i, j] = v
+        for i in range(3):
+            Iom[i] = Ig[i, 0] * om[0] + Ig[i, 1] * om[1] + Ig[i, 2] * om[2]
+        t = np.empty(3)                                # I_g Wdot Qd + w x I_g w
+        t[0] = Ig[0, 0] * wdot[0] + Ig[0, 1] * wdot[1] + Ig[0, 2] * wdot[2] \
+            + om[1] * Iom[2] - om[2] * Iom[1]
+        t[1] = Ig[1, 0] * wdot[0] + Ig[1, 1] * wdot[1] + Ig[1, 2] * wdot[2] \
+            + om[2] * Iom[0] - om[0] * Iom[2]
+        t[2] = Ig[2, 0] * wdot[0] + Ig[2, 1] * wdot[1] + Ig[2, 2] * wdot[2] \
+            + om[0] * Iom[1] - om[1] * Iom[0]
+        f = np.empty(3)
+        for i in range(3):
+            f[i] = m * (b_g[b, i] - acc[i])
+        for k in range(nc):
+            v = 0.0
+            for i in range(3):
+                v += J[i, k] * f[i] - W[i, k] * t[i]
+            Fe[b, k] = v
+            if with_mass:
+                for q in range(nc):
+                    v = 0.0
+                    for i in range(3):
+                        v += m * J[i, k] * J[i, q]
+                        for j in range(3):
+                            v += W[i, k] * Ig[i, j] * W[j, q]
+                    Me[b, k, q] = v
+    return FC[:B], FN[:B], Me, Fe
+
+
 if AVAILABLE:
     _planar_frame = numba.njit(cache=True, nogil=True)(_planar_frame)
     _point = point_compiled.compiled_point
@@ -347,10 +439,64 @@ if AVAILABLE:
     _cross = _jit(_cross)
     _joint_terms_compiled = _jit(_joint_terms)
     _joint_columns_compiled = _jit(_joint_columns)
+    _body_blocks_compiled = _jit(_body_blocks)
 
 
 _KINDS = {"coincidence": COINCIDENCE, "distance": DISTANCE, "hinge_axis": HINGE_AXIS,
           "planar_pin": PLANAR_PIN, "prismatic": PRISMATIC}
+
+
+def _frame_tables(obj, N, model, frames):
+    """Set the frame tables of ``frames`` (planar or beam specs; N coordinates) and the element
+    tables of ``model`` (None: planar frames only, empty tables) on ``obj``: the arguments of
+    _frame_local."""
+    obj.N = int(N)
+    if model is None:
+        obj.n, obj.i_s1 = 2, 0
+        obj.D_all = np.zeros((1, 6, 1))
+        obj.pow_p = np.zeros((1, 1), dtype=np.int64)
+        obj.pow_t = np.zeros((1, 1), dtype=np.int64)
+        obj.bases = np.zeros((0, 3, 3))
+        obj.el_idx = np.zeros((0, 4), dtype=np.int64)
+        first = np.zeros(1, dtype=np.int64)
+    else:
+        els = [el for b in model.beams for el in b.elements]
+        el0 = els[0]
+        obj.n, obj.i_s1 = int(el0.n), int(el0.i_s1)
+        obj.D_all = np.ascontiguousarray(el0.D_all, dtype=float)
+        obj.pow_p = np.ascontiguousarray(el0.pow_p, dtype=np.int64)
+        obj.pow_t = np.ascontiguousarray(el0.pow_t, dtype=np.int64)
+        obj.bases = np.ascontiguousarray(np.stack([el.G for el in els]), dtype=float)
+        obj.el_idx = np.stack([np.asarray(off + imap, dtype=np.int64)
+                               for b, off in zip(model.beams, model.offsets)
+                               for imap in b.index_map])
+        first = np.cumsum([0] + [len(b.elements) for b in model.beams])
+    F = len(frames)
+    obj.frames = frames
+    obj.f_kind = np.zeros(F, dtype=np.int64)
+    obj.f_idx = np.full((F, 4), -1, dtype=np.int64)
+    obj.f_C = np.zeros((F, 3, 3, 3))
+    obj.f_ax = np.zeros((F, 3))
+    obj.f_p = np.zeros((F, 3))
+    obj.f_s = np.zeros(F)
+    obj.f_hasoff = np.zeros(F, dtype=np.bool_)
+    for i, f in enumerate(frames):
+        spec = f.spec
+        if spec[0] == "planar":
+            _, _, cols, C0, S0, P0, ax, p = spec
+            obj.f_kind[i] = PLANAR
+            obj.f_idx[i] = cols
+            obj.f_C[i] = (C0, S0, P0)
+            obj.f_ax[i] = ax
+            obj.f_p[i] = p
+        else:                                    # ("beam", model, ibeam, s, p or None)
+            _, _, ibeam, s, p = spec
+            obj.f_kind[i] = BEAM
+            obj.f_idx[i, 0] = first[ibeam]
+            obj.f_s[i] = s
+            if p is not None:
+                obj.f_p[i] = p
+                obj.f_hasoff[i] = True
 
 
 class JointProgram:
@@ -358,44 +504,7 @@ class JointProgram:
     :func:`joint_program_for`."""
 
     def __init__(self, model, frames, cons):
-        els = [el for b in model.beams for el in b.elements]
-        el0 = els[0]
-        self.N = int(model.n_coords)
-        self.n, self.i_s1 = int(el0.n), int(el0.i_s1)
-        self.D_all = np.ascontiguousarray(el0.D_all, dtype=float)
-        self.pow_p = np.ascontiguousarray(el0.pow_p)
-        self.pow_t = np.ascontiguousarray(el0.pow_t)
-        self.bases = np.ascontiguousarray(np.stack([el.G for el in els]), dtype=float)
-        self.el_idx = np.stack([np.asarray(off + imap, dtype=np.int64)
-                                for b, off in zip(model.beams, model.offsets)
-                                for imap in b.index_map])
-        first = np.cumsum([0] + [len(b.elements) for b in model.beams])
-        F = len(frames)
-        self.frames = frames
-        self.f_kind = np.zeros(F, dtype=np.int64)
-        self.f_idx = np.full((F, 4), -1, dtype=np.int64)
-        self.f_C = np.zeros((F, 3, 3, 3))
-        self.f_ax = np.zeros((F, 3))
-        self.f_p = np.zeros((F, 3))
-        self.f_s = np.zeros(F)
-        self.f_hasoff = np.zeros(F, dtype=np.bool_)
-        for i, f in enumerate(frames):
-            spec = f.spec
-            if spec[0] == "planar":
-                _, cols, C0, S0, P0, ax, p = spec
-                self.f_kind[i] = PLANAR
-                self.f_idx[i] = cols
-                self.f_C[i] = (C0, S0, P0)
-                self.f_ax[i] = ax
-                self.f_p[i] = p
-            else:                                    # ("beam", model, ibeam, s, p or None)
-                _, _, ibeam, s, p = spec
-                self.f_kind[i] = BEAM
-                self.f_idx[i, 0] = first[ibeam]
-                self.f_s[i] = s
-                if p is not None:
-                    self.f_p[i] = p
-                    self.f_hasoff[i] = True
+        _frame_tables(self, model.n_coords, model, frames)
         where = {id(f): i for i, f in enumerate(frames)}
         K = len(cons)
         self.m = int(sum(c.m for c in cons))
@@ -508,3 +617,23 @@ def planar_frame(Q, n_coords, i_phi, iu, iv, it, C0, S0, P0, ax, p):
     W = np.zeros((3, n_coords), dtype=dt)
     _planar_frame(Q, i_phi, iu, iv, it, C0, S0, P0, ax, p, r, J, R, W)
     return r, J, R, W
+
+
+class BodyProgram:
+    """The Newton-Euler blocks of rigid bodies whose mass-centre frames are planar (body or
+    turntable) frames, in one compiled call (see _body_blocks); built by
+    :meth:`sim_core.physics.rigid_body.CompiledRigidBodies.build`."""
+
+    def __init__(self, N, frames, masses, inertias, gravities):
+        _frame_tables(self, N, None, frames)
+        self.b_mass = np.asarray(masses, dtype=float)
+        self.b_I = np.ascontiguousarray(inertias, dtype=float)
+        self.b_g = np.ascontiguousarray(gravities, dtype=float)
+
+    def blocks(self, Q, Qd, mass: bool = True):
+        """(cols (B, 4), ncols (B,), Me (B, 4, 4), Fe (B, 4)) at the real state (Q, Q_dot)."""
+        return _body_blocks_compiled(
+            np.ascontiguousarray(Q, dtype=float), np.ascontiguousarray(Qd, dtype=float),
+            self.N, self.f_kind, self.f_idx, self.f_C, self.f_ax, self.f_p, self.f_s,
+            self.f_hasoff, self.el_idx, self.n, self.D_all, self.pow_p, self.pow_t, self.bases,
+            self.i_s1, self.b_mass, self.b_I, self.b_g, bool(mass), COMPLEX_STEP)

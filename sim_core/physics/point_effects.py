@@ -259,8 +259,9 @@ class CompiledPointEffects:
                 dQ[:, cols] -= pe.tension_rate(float(g[sl.start])) * np.outer(row, row[cols])
         return dQ, dQd
 
-    def local(self, Q, Qd, mass=True) -> list:
-        """[(idx, Me or None, Fe)] of every effect, in the model's order (as its ``local``)."""
+    def local(self, Q, Qd, mass=True, t=float("nan")) -> list:
+        """[(idx, Me or None, Fe)] of every effect, in the model's order (as its ``local``;
+        the time-invariant uncompiled effects get ``t``)."""
         g, G, quad, _ = self.program.terms(Q, Qd)
         out = []
         for pe, sl in zip(self.effects, self.rows):
@@ -277,5 +278,4 @@ class CompiledPointEffects:
                 out.append((idx, None, -pe.tension(float(g[sl.start])) * grad[idx]))
         if not self.uncompiled:
             return out
-        return [out[k] if compiled else k.local(float("nan"), Q, Qd, mass)
-                for compiled, k in self.order]
+        return [out[k] if compiled else k.local(t, Q, Qd, mass) for compiled, k in self.order]

@@ -148,7 +148,7 @@ def turntable_frame(n_coords: int, i_phi: int, slew_axis, plane_basis, point=(0.
         W[:, i_phi] = ax
         return r, J, R, W
     f = _memo(fun, lambda Q: cols)
-    f.spec = ("planar", (i_phi, -1, -1, -1), C0, S0, P0, ax, p)    # joint_compiled
+    f.spec = ("planar", n_coords, (i_phi, -1, -1, -1), C0, S0, P0, ax, p)   # frame_compiled
     return f
 
 
@@ -190,7 +190,7 @@ def planar_body_frame(n_coords: int, i_phi: int, i_body: int, slew_axis, plane_b
         R[:, 2] = n
         return r, J, R, W
     f = _memo(fun, lambda Q: cols)
-    f.spec = ("planar", (i_phi, iu, iv, it), C0, S0, P0, ax, p)     # joint_compiled
+    f.spec = ("planar", n_coords, (i_phi, iu, iv, it), C0, S0, P0, ax, p)    # frame_compiled
     return f
 
 
@@ -247,7 +247,7 @@ def beam_frame(model, ibeam: int, s: float, point_global_offset=None, frame0=Non
         W[:, idx] = Wl
         return r, J, R, W
     f = _memo(fun, cols)
-    f.spec = ("beam", model, ibeam, float(s), p)                   # joint_compiled
+    f.spec = ("beam", model, ibeam, float(s), p)                   # frame_compiled
     return f
 
 
@@ -301,6 +301,76 @@ class RigidBody:
         v = J @ Qd
         Ig = R @ np.asarray(self.inertia, float) @ R.T
         return self.mass * v, np.cross(r - point, self.mass * v) + Ig @ (W @ Qd)
+
+
+class CompiledRigidBodies:
+    """The local blocks of the rigid bodies among a model's point effects from one compiled
+    call (:class:`sim_core.physics._rigid_body_numba.BodyProgram`: the formulas of
+    :meth:`RigidBody.local`, the reference; ``tests/folding/test_joint_program.py`` compares
+    both); the other effects with a ``local`` form are evaluated in Python beside it
+    (``uncompiled``).  The interface of :class:`sim_core.physics.point_effects.CompiledPointEffects`
+    (``local``, ``jacobian``, ``uncompiled``)."""
+
+    def __init__(self, program, order, uncompiled, N):
+        self.program, self.order, self.uncompiled, self.N = program, order, uncompiled, N
+
+    @staticmethod
+    def build(effects) -> "CompiledRigidBodies | None":
+        """None where numba is off, no rigid body is there, a body's mass-centre frame is not
+        a planar frame, or another effect has no ``local`` form."""
+        if not (COMPILED_PLANAR_FRAMES and frame_compiled.AVAILABLE):
+            return None
+        bodies = [pe for pe in effects if type(pe) is RigidBody]
+        other = [pe for pe in effects if type(pe) is not RigidBody]
+        specs = [getattr(b.com, "spec", None) for b in bodies]
+        if (not bodies or any(sp is None or sp[0] != "planar" for sp in specs)
+                or not all(hasattr(pe, "local") for pe in other)):
+            return None
+        N = specs[0][1]
+        order, k = [], 0
+        for pe in effects:
+            order.append((True, k) if type(pe) is RigidBody else (False, pe))
+            k += type(pe) is RigidBody
+        program = frame_compiled.BodyProgram(
+            N, [b.com for b in bodies], [b.mass for b in bodies],
+            [np.asarray(b.inertia, float) for b in bodies],
+            [np.zeros(3) if b.gravity is None else np.asarray(b.gravity, float)
+             for b in bodies])
+        return CompiledRigidBodies(program, order, other, N)
+
+    def _bodies(self, Q, Qd, mass):
+        cols, nc, Me, Fe = self.program.blocks(Q, Qd, mass)
+        return [(cols[b, :nc[b]].copy(), Me[b, :nc[b], :nc[b]].copy() if mass else None,
+                 Fe[b, :nc[b]].copy()) for b in range(len(nc))]
+
+    def local(self, Q, Qd, mass=True, t=float("nan")) -> list:
+        """[(idx, Me or None, Fe)] of every effect, in the model's order (as its ``local``)."""
+        out = self._bodies(Q, Qd, mass)
+        return [out[k] if compiled else k.local(t, Q, Qd, mass) for compiled, k in self.order]
+
+    def jacobian(self, Q, Qd, Qdd, steps):
+        """(d/dQ, d/dQ_dot) (N, N) of the bodies' F - M Q_ddot at frozen Q_ddot (their pieces
+        of the structured Jacobian, :mod:`sim_core.model.state_jacobian`) by forward
+        differences with the steps ``steps(x)`` in the bodies' columns, every body at once."""
+        N = self.N
+
+        def residual(Qx, Qdx):
+            r = np.zeros(N)
+            for idx, Me, Fe in self._bodies(Qx, Qdx, True):
+                r[idx] += Fe - Me @ Qdd[idx]
+            return r
+        cols = np.unique(np.concatenate([idx for idx, _, _ in self._bodies(Q, Qd, False)]))
+        base = residual(Q, Qd)
+        dQ = np.zeros((N, N))
+        dQd = np.zeros((N, N))
+        for D, x in ((dQ, Q.copy()), (dQd, Qd.copy())):
+            for j, h in zip(cols, steps(x[cols])):
+                xj = x[j]
+                x[j] = xj + h
+                up = residual(x, Qd) if D is dQ else residual(Q, x)
+                x[j] = xj
+                D[:, j] = (up - base) / h
+        return dQ, dQd
 
 
 @dataclass
