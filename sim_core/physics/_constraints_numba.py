@@ -423,30 +423,37 @@ def program_for(cons) -> ConstraintProgram | None:
     the list changes), or None where it does not cover the list: numba missing, a constraint
     without ``program``, a point that is neither a material nor a fixed point, points of more
     than one model, or elements with unequal tables."""
+    return cached_program(cons, "_compiled_program", _build)
+
+
+def cached_program(cons, slot: str, build):
+    """``build(cons)`` cached on the list's first constraint under ``slot`` and rebuilt when
+    the list changes; None without numba or constraints."""
     if not AVAILABLE or not cons:
         return None
     key = tuple(id(c) for c in cons)
-    hit = cons[0].__dict__.get("_compiled_program")
+    hit = cons[0].__dict__.get(slot)
     if hit is not None and hit[0] == key:
         return hit[1]
-    prog = _build(cons)
-    cons[0].__dict__["_compiled_program"] = (key, prog)
+    prog = build(cons)
+    cons[0].__dict__[slot] = (key, prog)
     return prog
 
 
-def _build(cons):
+def program_points(cons, attr: str, kinds: tuple, model_kind: str):
+    """(the point functions of the constraints' ``attr`` programs in first-use order, their
+    model) or None where a constraint has no such program, a point's ``spec`` kind is not in
+    ``kinds``, or the points of kind ``model_kind`` belong to more than one model (or none)."""
     points, seen, model = [], set(), None
     for c in cons:
-        spec = getattr(c, "program", None)
+        spec = getattr(c, attr, None)
         if spec is None:
             return None
         for f in spec[2]:
             s = getattr(f, "spec", None)
-            if s is None:
+            if s is None or s[0] not in kinds:
                 return None
-            if s[0] not in ("material", "fixed"):     # a rigid frame: _rigid_body_numba
-                return None
-            if s[0] == "material":
+            if s[0] == model_kind:
                 if model is None:
                     model = s[1]
                 elif s[1] is not model:
@@ -454,14 +461,23 @@ def _build(cons):
             if id(f) not in seen:
                 seen.add(id(f))
                 points.append(f)
-    if model is None:
-        return None
+    return None if model is None else (points, model)
+
+
+def equal_element_tables(model) -> bool:
+    """Whether every element of the model has the first one's tables (one compiled kernel
+    call serves all)."""
     els = [el for b in model.beams for el in b.elements]
     el0 = els[0]
-    for el in els:
-        if (el.n != el0.n or el.i_s1 != el0.i_s1 or len(el.G) != 3
-                or not np.array_equal(el.D_all, el0.D_all)
-                or not np.array_equal(el.pow_p, el0.pow_p)
-                or not np.array_equal(el.pow_t, el0.pow_t)):
-            return None
+    return all(el.n == el0.n and el.i_s1 == el0.i_s1 and len(el.G) == 3
+               and np.array_equal(el.D_all, el0.D_all)
+               and np.array_equal(el.pow_p, el0.pow_p)
+               and np.array_equal(el.pow_t, el0.pow_t) for el in els)
+
+
+def _build(cons):
+    found = program_points(cons, "program", ("material", "fixed"), "material")
+    if found is None or not equal_element_tables(found[1]):
+        return None
+    points, model = found
     return ConstraintProgram(model, points, cons)

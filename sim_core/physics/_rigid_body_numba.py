@@ -47,6 +47,11 @@ from __future__ import annotations
 import numpy as np
 
 from sim_core._numba import AVAILABLE, numba
+from sim_core.physics._constraints_numba import (
+    cached_program,
+    equal_element_tables,
+    program_points,
+)
 from sim_core.physics.beam import _cardan_numba as cardan_compiled
 from sim_core.physics.beam import _moving_node_beam_numba as point_compiled
 from sim_core.physics.complex_step import COMPLEX_STEP
@@ -55,15 +60,18 @@ PLANAR, BEAM = 0, 1                                   # frame kinds
 COINCIDENCE, DISTANCE, HINGE_AXIS, PLANAR_PIN, PRISMATIC = 0, 1, 2, 3, 4   # row kinds
 
 
-def _planar_frame(Q, i_phi, iu, iv, it, C0, S0, P0, ax, p, r, J, R, W):
-    """Fill r (3,), J (3, N), R (3, 3), W (3, N) (J, W zero on entry) of the frame; iu < 0:
-    the turntable (no body coordinates)."""
+def _planar_local(Q, i_phi, iu, iv, it, C0, S0, P0, ax, p, r, J, R, W):
+    """Fill r (3,), R (3, 3) and the columns (phi, u, v, theta) of J, W (3, >= 4) of the frame;
+    iu < 0: the turntable, whose only column is phi's."""
     phi = Q[i_phi]
     c = np.cos(phi)
     s = np.sin(phi)
     for i in range(3):
         for k in range(3):
             R[i, k] = c * C0[i, k] + s * S0[i, k] + P0[i, k]
+        for k in range(4):
+            J[i, k] = 0.0
+            W[i, k] = 0.0
     if iu >= 0:
         th = Q[it]
         ct = np.cos(th)
@@ -77,20 +85,36 @@ def _planar_frame(Q, i_phi, iu, iv, it, C0, S0, P0, ax, p, r, J, R, W):
             ev = R[i, 1]
             n = R[i, 2]
             r[i] = a0 * eu + a1 * ev + p[2] * n
-            J[i, iu] = eu
-            J[i, iv] = ev
-            J[i, it] = d0 * eu + d1 * ev
-            W[i, it] = n
+            J[i, 1] = eu
+            J[i, 2] = ev
+            J[i, 3] = d0 * eu + d1 * ev
+            W[i, 3] = n
             R[i, 0] = ct * eu + st * ev
             R[i, 1] = ct * ev - st * eu
     else:
         for i in range(3):
             r[i] = R[i, 0] * p[0] + R[i, 1] * p[1] + R[i, 2] * p[2]
-    J[0, i_phi] = ax[1] * r[2] - ax[2] * r[1]
-    J[1, i_phi] = ax[2] * r[0] - ax[0] * r[2]
-    J[2, i_phi] = ax[0] * r[1] - ax[1] * r[0]
+    J[0, 0] = ax[1] * r[2] - ax[2] * r[1]
+    J[1, 0] = ax[2] * r[0] - ax[0] * r[2]
+    J[2, 0] = ax[0] * r[1] - ax[1] * r[0]
     for i in range(3):
-        W[i, i_phi] = ax[i]
+        W[i, 0] = ax[i]
+
+
+def _planar_frame(Q, i_phi, iu, iv, it, C0, S0, P0, ax, p, r, J, R, W):
+    """Fill r (3,), J (3, N), R (3, 3), W (3, N) (J, W zero on entry) of the frame; iu < 0:
+    the turntable (no body coordinates)."""
+    Jl = np.empty((3, 4), dtype=J.dtype)
+    Wl = np.empty((3, 4), dtype=W.dtype)
+    _planar_local(Q, i_phi, iu, iv, it, C0, S0, P0, ax, p, r, Jl, R, Wl)
+    for i in range(3):
+        J[i, i_phi] = Jl[i, 0]
+        W[i, i_phi] = Wl[i, 0]
+        if iu >= 0:
+            J[i, iu] = Jl[i, 1]
+            J[i, iv] = Jl[i, 2]
+            J[i, it] = Jl[i, 3]
+            W[i, it] = Wl[i, 3]
 
 
 def _frame_local(f, Qc, f_kind, f_idx, f_C, f_ax, f_p, f_s, f_hasoff, el_idx, n, D_all,
@@ -98,53 +122,12 @@ def _frame_local(f, Qc, f_kind, f_idx, f_C, f_ax, f_p, f_s, f_hasoff, el_idx, n,
     """Frame f at the complex state Qc into Rf[f] (3,), Rot[f] (3, 3), and Jf[f], Wf[f] (3, L)
     on its columns FC[f, :FN[f]]; returns the finite-check sum."""
     if f_kind[f] == PLANAR:
-        i_phi, iu, iv, it = f_idx[f, 0], f_idx[f, 1], f_idx[f, 2], f_idx[f, 3]
-        phi = Qc[i_phi]
-        c = np.cos(phi)
-        s = np.sin(phi)
-        for i in range(3):
-            for k in range(3):
-                Rot[f, i, k] = c * f_C[f, 0, i, k] + s * f_C[f, 1, i, k] + f_C[f, 2, i, k]
-        p = f_p[f]
-        ax = f_ax[f]
-        for i in range(3):
-            for k in range(4):
-                Jf[f, i, k] = 0.0
-                Wf[f, i, k] = 0.0
-        FC[f, 0] = i_phi
-        if iu >= 0:
-            FC[f, 1] = iu
-            FC[f, 2] = iv
-            FC[f, 3] = it
-            FN[f] = 4
-            th = Qc[it]
-            ct = np.cos(th)
-            st = np.sin(th)
-            a0 = Qc[iu] + (ct * p[0] - st * p[1])
-            a1 = Qc[iv] + (st * p[0] + ct * p[1])
-            d0 = -st * p[0] - ct * p[1]
-            d1 = ct * p[0] - st * p[1]
-            for i in range(3):
-                eu = Rot[f, i, 0]
-                ev = Rot[f, i, 1]
-                nn = Rot[f, i, 2]
-                Rf[f, i] = a0 * eu + a1 * ev + p[2] * nn
-                Jf[f, i, 1] = eu
-                Jf[f, i, 2] = ev
-                Jf[f, i, 3] = d0 * eu + d1 * ev
-                Wf[f, i, 3] = nn
-                Rot[f, i, 0] = ct * eu + st * ev
-                Rot[f, i, 1] = ct * ev - st * eu
-        else:
-            FN[f] = 1
-            for i in range(3):
-                Rf[f, i] = Rot[f, i, 0] * p[0] + Rot[f, i, 1] * p[1] + Rot[f, i, 2] * p[2]
-        r = Rf[f]
-        Jf[f, 0, 0] = ax[1] * r[2] - ax[2] * r[1]
-        Jf[f, 1, 0] = ax[2] * r[0] - ax[0] * r[2]
-        Jf[f, 2, 0] = ax[0] * r[1] - ax[1] * r[0]
-        for i in range(3):
-            Wf[f, i, 0] = ax[i]
+        iu = f_idx[f, 1]
+        _planar_local(Qc, f_idx[f, 0], iu, f_idx[f, 2], f_idx[f, 3], f_C[f, 0], f_C[f, 1],
+                      f_C[f, 2], f_ax[f], f_p[f], Rf[f], Jf[f], Rot[f], Wf[f])
+        FN[f] = 4 if iu >= 0 else 1
+        for k in range(FN[f]):
+            FC[f, k] = f_idx[f, k]
         return 0.0
     # BEAM: the section frame of element f_idx[f, 0] at the material point f_s[f]
     e = f_idx[f, 0]
@@ -186,6 +169,28 @@ def _frame_local(f, Qc, f_kind, f_idx, f_C, f_ax, f_p, f_s, f_hasoff, el_idx, n,
     return total
 
 
+def _frames(Q, Qd, N, f_kind, f_idx, f_C, f_ax, f_p, f_s, f_hasoff, el_idx, n, D_all, pow_p,
+            pow_t, bases, i_s1, cstep):
+    """Every frame at the complex-step state Q + i cstep Q_dot (_frame_local): (Rf (F, 3), Jf
+    (F, 3, L), Rot (F, 3, 3), Wf (F, 3, L), FC (F, L), FN (F,), finite-check sum)."""
+    Qc = np.empty(N, dtype=np.complex128)
+    for k in range(N):
+        Qc[k] = Q[k] + 1j * (cstep * Qd[k])
+    F = f_kind.shape[0]
+    L = max(el_idx.shape[1], 4)
+    Rf = np.empty((F, 3), dtype=np.complex128)
+    Rot = np.empty((F, 3, 3), dtype=np.complex128)
+    Jf = np.zeros((F, 3, L), dtype=np.complex128)
+    Wf = np.zeros((F, 3, L), dtype=np.complex128)
+    FC = np.zeros((F, L), dtype=np.int64)
+    FN = np.zeros(F, dtype=np.int64)
+    total = 0.0
+    for f in range(F):
+        total += _frame_local(f, Qc, f_kind, f_idx, f_C, f_ax, f_p, f_s, f_hasoff, el_idx, n,
+                              D_all, pow_p, pow_t, bases, i_s1, Rf, Jf, Rot, Wf, FC, FN)
+    return Rf, Jf, Rot, Wf, FC, FN, total
+
+
 def _add_row(Gc, row, f, coef, X, FC, FN):
     """Gc[row, FC[f, k]] += coef . X[f, :, k] (coef (3,) complex, X = Jf or Wf)."""
     for k in range(FN[f]):
@@ -202,21 +207,9 @@ def _joint_terms(Q, Qd, N, f_kind, f_idx, f_C, f_ax, f_p, f_s, f_hasoff, el_idx,
                  pow_p, pow_t, bases, i_s1, c_kind, c_f, c_vec, c_row0, m, cstep, rate_part):
     """(g (m,), G (m, N), g_QQ[Q_dot, Q_dot] (m,), g_QQ Q_dot (m, N) or (0, 0), finite-check
     sum) of the joint rows at the real state (Q, Q_dot); see the module docstring."""
-    Qc = np.empty(N, dtype=np.complex128)
-    for k in range(N):
-        Qc[k] = Q[k] + 1j * (cstep * Qd[k])
-    F = f_kind.shape[0]
-    L = max(el_idx.shape[1], 4)
-    Rf = np.empty((F, 3), dtype=np.complex128)
-    Rot = np.empty((F, 3, 3), dtype=np.complex128)
-    Jf = np.zeros((F, 3, L), dtype=np.complex128)
-    Wf = np.zeros((F, 3, L), dtype=np.complex128)
-    FC = np.zeros((F, L), dtype=np.int64)
-    FN = np.zeros(F, dtype=np.int64)
-    total = 0.0
-    for f in range(F):
-        total += _frame_local(f, Qc, f_kind, f_idx, f_C, f_ax, f_p, f_s, f_hasoff, el_idx, n,
-                              D_all, pow_p, pow_t, bases, i_s1, Rf, Jf, Rot, Wf, FC, FN)
+    Rf, Jf, Rot, Wf, FC, FN, total = _frames(Q, Qd, N, f_kind, f_idx, f_C, f_ax, f_p, f_s,
+                                             f_hasoff, el_idx, n, D_all, pow_p, pow_t, bases,
+                                             i_s1, cstep)
     gc = np.zeros(m, dtype=np.complex128)
     Gc = np.zeros((m, N), dtype=np.complex128)
     d = np.empty(3, dtype=np.complex128)
@@ -352,17 +345,9 @@ def _body_blocks(Q, Qd, N, f_kind, f_idx, f_C, f_ax, f_p, f_s, f_hasoff, el_idx,
         Me = m J^T J + W^T I_g W,  Fe = J^T m (g - Jdot Qd) - W^T (I_g Wdot Qd + w x I_g w),
     I_g = R I_b R^T, w = W Qd, Jdot Qd and Wdot Qd the imaginary parts of the frame's Jacobians
     at Q + i h Qd times Qd, over h.  Returns (cols (B, L), ncols (B,), Me (B, L, L), Fe (B, L))."""
-    Qc = np.empty(N, dtype=np.complex128)
-    for k in range(N):
-        Qc[k] = Q[k] + 1j * (cstep * Qd[k])
-    F = f_kind.shape[0]
-    L = max(el_idx.shape[1], 4)
-    Rf = np.empty((F, 3), dtype=np.complex128)
-    Rot = np.empty((F, 3, 3), dtype=np.complex128)
-    Jf = np.zeros((F, 3, L), dtype=np.complex128)
-    Wf = np.zeros((F, 3, L), dtype=np.complex128)
-    FC = np.zeros((F, L), dtype=np.int64)
-    FN = np.zeros(F, dtype=np.int64)
+    _, Jf, Rot, Wf, FC, FN, _ = _frames(Q, Qd, N, f_kind, f_idx, f_C, f_ax, f_p, f_s, f_hasoff,
+                                        el_idx, n, D_all, pow_p, pow_t, bases, i_s1, cstep)
+    L = Jf.shape[2]
     B = b_mass.shape[0]
     Me = np.zeros((B, L, L))
     Fe = np.zeros((B, L))
@@ -375,8 +360,6 @@ def _body_blocks(Q, Qd, N, f_kind, f_idx, f_C, f_ax, f_p, f_s, f_hasoff, el_idx,
     om = np.empty(3)
     Iom = np.empty(3)
     for b in range(B):
-        _frame_local(b, Qc, f_kind, f_idx, f_C, f_ax, f_p, f_s, f_hasoff, el_idx, n, D_all,
-                     pow_p, pow_t, bases, i_s1, Rf, Jf, Rot, Wf, FC, FN)
         nc = FN[b]
         m = b_mass[b]
         for i in range(3):
@@ -427,19 +410,34 @@ def _body_blocks(Q, Qd, N, f_kind, f_idx, f_C, f_ax, f_p, f_s, f_hasoff, el_idx,
                         for j in range(3):
                             v += W[i, k] * Ig[i, j] * W[j, q]
                     Me[b, k, q] = v
-    return FC[:B], FN[:B], Me, Fe
+    return FC, FN, Me, Fe
 
 
 if AVAILABLE:
-    _planar_frame = numba.njit(cache=True, nogil=True)(_planar_frame)
-    _point = point_compiled.compiled_point
     _jit = numba.njit(cache=True, nogil=True)
+    _planar_local = _jit(_planar_local)
+    _planar_frame = _jit(_planar_frame)
+    _point = point_compiled.compiled_point
     _frame_local = _jit(_frame_local)
+    _frames = _jit(_frames)
     _add_row = _jit(_add_row)
     _cross = _jit(_cross)
     _joint_terms_compiled = _jit(_joint_terms)
     _joint_columns_compiled = _jit(_joint_columns)
     _body_blocks_compiled = _jit(_body_blocks)
+
+
+def planar_frame(Q, n_coords, i_phi, iu, iv, it, C0, S0, P0, ax, p):
+    """(r, J, R, W) of a planar body (iu >= 0) or turntable (iu = -1) frame at Q (float64 or
+    complex128), by the compiled loop where numba is on (else the same loop in Python)."""
+    dt = np.result_type(Q, float)
+    Q = np.ascontiguousarray(Q, dtype=dt)
+    r = np.empty(3, dtype=dt)
+    R = np.empty((3, 3), dtype=dt)
+    J = np.zeros((3, n_coords), dtype=dt)
+    W = np.zeros((3, n_coords), dtype=dt)
+    _planar_frame(Q, i_phi, iu, iv, it, C0, S0, P0, ax, p, r, J, R, W)
+    return r, J, R, W
 
 
 _KINDS = {"coincidence": COINCIDENCE, "distance": DISTANCE, "hinge_axis": HINGE_AXIS,
@@ -564,59 +562,17 @@ def joint_program_for(cons) -> JointProgram | None:
     list changes), or None where it does not cover the list: numba missing, a constraint
     without ``joint_program``, a frame without a planar or beam ``spec``, frames of more than one
     model, a beam of more than one element, or elements with unequal tables."""
-    if not AVAILABLE or not cons:
-        return None
-    key = tuple(id(c) for c in cons)
-    hit = cons[0].__dict__.get("_joint_program")
-    if hit is not None and hit[0] == key:
-        return hit[1]
-    prog = _build(cons)
-    cons[0].__dict__["_joint_program"] = (key, prog)
-    return prog
+    return cached_program(cons, "_joint_program", _build)
 
 
 def _build(cons):
-    frames, seen, model = [], set(), None
-    for c in cons:
-        spec = getattr(c, "joint_program", None)
-        if spec is None:
-            return None
-        for f in spec[2]:
-            s = getattr(f, "spec", None)
-            if s is None or s[0] not in ("planar", "beam"):
-                return None
-            if s[0] == "beam":
-                if model is None:
-                    model = s[1]
-                elif s[1] is not model:
-                    return None
-            if id(f) not in seen:
-                seen.add(id(f))
-                frames.append(f)
-    if model is None or any(len(b.elements) != 1 for b in model.beams):
+    found = program_points(cons, "joint_program", ("planar", "beam"), "beam")
+    if found is None:
         return None
-    els = [el for b in model.beams for el in b.elements]
-    el0 = els[0]
-    for el in els:
-        if (el.n != el0.n or el.i_s1 != el0.i_s1 or len(el.G) != 3
-                or not np.array_equal(el.D_all, el0.D_all)
-                or not np.array_equal(el.pow_p, el0.pow_p)
-                or not np.array_equal(el.pow_t, el0.pow_t)):
-            return None
+    frames, model = found
+    if any(len(b.elements) != 1 for b in model.beams) or not equal_element_tables(model):
+        return None
     return JointProgram(model, frames, cons)
-
-
-def planar_frame(Q, n_coords, i_phi, iu, iv, it, C0, S0, P0, ax, p):
-    """(r, J, R, W) of a planar body (iu >= 0) or turntable (iu = -1) frame at Q (float64 or
-    complex128), by the compiled loop where numba is on (else the same loop in Python)."""
-    dt = np.result_type(Q, float)
-    Q = np.ascontiguousarray(Q, dtype=dt)
-    r = np.empty(3, dtype=dt)
-    R = np.empty((3, 3), dtype=dt)
-    J = np.zeros((3, n_coords), dtype=dt)
-    W = np.zeros((3, n_coords), dtype=dt)
-    _planar_frame(Q, i_phi, iu, iv, it, C0, S0, P0, ax, p, r, J, R, W)
-    return r, J, R, W
 
 
 class BodyProgram:

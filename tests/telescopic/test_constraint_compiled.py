@@ -13,9 +13,10 @@ import pytest
 from sim_core.model import state_jacobian
 from sim_core.physics import _constraints_numba as constraint_compiled
 from sim_core.physics import constraints
-from sim_core.physics.constraints import NonlinearConstraint, constraint_terms, material_point
+from sim_core.physics.constraints import constraint_terms, material_point
 from sim_core.systems.telescopic.params import TelescopicParams
 from sim_core.systems.telescopic.build import build_telescopic, initial_equilibrium
+from tests.compiled_rows import assert_rows_equal_python, height_row, jacobian_difference
 
 pytestmark = pytest.mark.skipif(not constraint_compiled.AVAILABLE, reason="numba not installed")
 
@@ -49,41 +50,17 @@ def test_program_covers_the_scene_constraints(state):
 
 
 def test_rows_equal_the_python_closures(state, monkeypatch):
-    """Phi, G = g_Q, Phi_dot and b_ddot - g_QQ[Q_dot, Q_dot]: the same algebra in another
-    order, so equal to round-off of each quantity's scale (Phi_dot = G Q_dot - b_dot and the
-    quadratic term are sums of terms of size |G| |Q_dot| and |G_Q| |Q_dot|^2 that nearly
-    cancel: their tolerance is round-off of those sizes)."""
     _, ts, z, zd = state
     m = ts.model
-    t = 0.7
-    Q, Qd = m.full_state(t, z, zd)
-    monkeypatch.setattr(constraints, "COMPILED_ROWS", False)
-    ref = constraint_terms(m.nonlinear, t, Q, Qd)
-    monkeypatch.setattr(constraints, "COMPILED_ROWS", True)
-    got = constraint_terms(m.nonlinear, t, Q, Qd)
-    phi, G, dphi, rhs = ref
-    gq = np.abs(G).max() * np.abs(Qd).max()
-    for name, a, b, scale in (("phi", got[0], phi, max(np.abs(phi).max(), 1e-3)),
-                              ("G", got[1], G, np.abs(G).max()),
-                              ("dphi", got[2], dphi, gq),
-                              ("rhs", got[3], rhs, max(np.abs(rhs).max(), gq))):
-        np.testing.assert_allclose(a, b, rtol=0, atol=1e-12 * scale, err_msg=name)
+    Q, Qd = m.full_state(0.7, z, zd)
+    assert_rows_equal_python(m.nonlinear, 0.7, Q, Qd, monkeypatch)
 
 
 def test_jacobian_columns_equal_the_python_pieces(state, monkeypatch):
-    """The structured Jacobian with the constraint columns from the compiled sweep against the
-    Python pieces differenced column by column: the same forward differences with the same
-    steps of values equal to round-off, so they agree to round-off / step (eps / 1.5e-8 ~ 1e-8
-    of each row's scale; 1e-6 allowed)."""
     _, ts, z, zd = state
-    m = ts.model
     y = np.concatenate([z, zd])
-    monkeypatch.setattr(state_jacobian, "COMPILED_CONSTRAINT_COLUMNS", False)
-    ref = state_jacobian.state_jacobian(m, 0.7, y)
-    monkeypatch.setattr(state_jacobian, "COMPILED_CONSTRAINT_COLUMNS", True)
-    got = state_jacobian.state_jacobian(m, 0.7, y)
-    scale = np.maximum(np.abs(ref).max(axis=1, keepdims=True), 1e-300)
-    assert np.max(np.abs(got - ref) / scale) < 1e-6
+    assert jacobian_difference(ts.model, 0.7, y, monkeypatch, state_jacobian,
+                               "COMPILED_CONSTRAINT_COLUMNS") < 1e-6
 
 
 def test_a_constraint_without_program_takes_the_python_path(state):
@@ -92,11 +69,7 @@ def test_a_constraint_without_program_takes_the_python_path(state):
     _, ts, z, zd = state
     m = ts.model
     tip = material_point(m, len(m.beams) - 1, s_fixed=m.beams[-1].length)
-
-    def evaluate(Q):
-        r, J, _, _ = tip(Q)
-        return r[2:3], J[2:3]
-    extra = NonlinearConstraint("tip_height", 1, evaluate, points=(tip,))
+    extra = height_row(tip)
     cons = list(m.nonlinear) + [extra]
     assert constraint_compiled.program_for(cons) is None
     Q, Qd = m.full_state(0.0, z, zd)
