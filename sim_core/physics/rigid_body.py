@@ -359,7 +359,8 @@ class CompiledRigidBodies:
             for idx, Me, Fe in self._bodies(Qx, Qdx, True):
                 r[idx] += Fe - Me @ Qdd[idx]
             return r
-        cols = np.unique(np.concatenate([idx for idx, _, _ in self._bodies(Q, Qd, False)]))
+        f_idx = self.program.f_idx                 # planar frames: fixed columns
+        cols = np.unique(f_idx[f_idx >= 0])
         base = residual(Q, Qd)
         dQ = np.zeros((N, N))
         dQd = np.zeros((N, N))
