@@ -175,6 +175,27 @@ def _add_local(terms, M, F) -> None:
         M[np.ix_(idx, idx)] += Me
 
 
+def compiled_order(effects, compiled_types) -> list:
+    """A model's point effects in order as (True, index among the compiled ones) for an effect
+    of ``compiled_types``, else (False, the effect): the merge plan of
+    :func:`in_model_order`."""
+    order, k = [], 0
+    for pe in effects:
+        if type(pe) in compiled_types:
+            order.append((True, k))
+            k += 1
+        else:
+            order.append((False, pe))
+    return order
+
+
+def in_model_order(order, compiled_blocks, t, Q, Qd, mass) -> list:
+    """[(idx, Me or None, Fe)] of every effect in the model's order: the compiled blocks by
+    ``order`` (:func:`compiled_order`), the other effects' own ``local`` at time t."""
+    return [compiled_blocks[k] if compiled else k.local(t, Q, Qd, mass)
+            for compiled, k in order]
+
+
 class CompiledPointEffects:
     """The local blocks of a list of payloads and ropes from one compiled evaluation of their
     points (:mod:`sim_core.physics._constraints_numba`: a rope's length is a chain of distances, the
@@ -203,13 +224,7 @@ class CompiledPointEffects:
         if not compiled or not all(getattr(pe, "time_invariant", False) and hasattr(pe, "local")
                                    for pe in other):
             return None
-        order, k = [], 0
-        for pe in effects:
-            if type(pe) in (PointMass, RopeDrive):
-                order.append((True, k))
-                k += 1
-            else:
-                order.append((False, pe))
+        order = compiled_order(effects, (PointMass, RopeDrive))
         cons, rows, row = [], [], 0
         for pe in compiled:
             if isinstance(pe, PointMass):
@@ -278,4 +293,4 @@ class CompiledPointEffects:
                 out.append((idx, None, -pe.tension(float(g[sl.start])) * grad[idx]))
         if not self.uncompiled:
             return out
-        return [out[k] if compiled else k.local(t, Q, Qd, mass) for compiled, k in self.order]
+        return in_model_order(self.order, out, t, Q, Qd, mass)

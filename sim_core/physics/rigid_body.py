@@ -44,6 +44,7 @@ from sim_core.physics import _rigid_body_numba as frame_compiled
 from sim_core.physics.beam import _moving_node_beam_numba as point_compiled
 from sim_core.physics.complex_step import COMPLEX_STEP
 from sim_core.physics.constraints import NonlinearConstraint, StateMemo
+from sim_core.physics.point_effects import compiled_order, in_model_order
 
 # beam section frames from the compiled point kernel; False: the element's numpy evaluate (the
 # reference of tests/folding/test_rigid_body_paths.py)
@@ -327,10 +328,7 @@ class CompiledRigidBodies:
                 or not all(hasattr(pe, "local") for pe in other)):
             return None
         N = specs[0][1]
-        order, k = [], 0
-        for pe in effects:
-            order.append((True, k) if type(pe) is RigidBody else (False, pe))
-            k += type(pe) is RigidBody
+        order = compiled_order(effects, (RigidBody,))
         program = frame_compiled.BodyProgram(
             N, [b.com for b in bodies], [b.mass for b in bodies],
             [np.asarray(b.inertia, float) for b in bodies],
@@ -345,8 +343,7 @@ class CompiledRigidBodies:
 
     def local(self, Q, Qd, mass=True, t=float("nan")) -> list:
         """[(idx, Me or None, Fe)] of every effect, in the model's order (as its ``local``)."""
-        out = self._bodies(Q, Qd, mass)
-        return [out[k] if compiled else k.local(t, Q, Qd, mass) for compiled, k in self.order]
+        return in_model_order(self.order, self._bodies(Q, Qd, mass), t, Q, Qd, mass)
 
     def jacobian(self, Q, Qd, Qdd, steps):
         """(d/dQ, d/dQ_dot) (N, N) of the bodies' F - M Q_ddot at frozen Q_ddot (their pieces
