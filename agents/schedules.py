@@ -8,8 +8,8 @@ error is O(dt^2) times the jump of dv/dt across a kink; zero for the C^1 cubic).
 
 Schedules (all extract 2 -> 8 m, i.e. travel 6 m; times in s):
 
-* ``cubic``: the paper's schedule (Zhao-Qi-Wang 2024 Sec. 9, SCENARIOS A4): smoothstep ramp
-  0 -> 0.5 m/s in 4 s, hold to 12 s, mirrored ramp-down to rest at 16 s
+* ``cubic``: the paper's schedule (Zhao-Qi-Wang 2024 Sec. 9, docs/model.md#input-drive):
+  smoothstep ramp 0 -> 0.5 m/s in 4 s, hold to 12 s, mirrored ramp-down to rest at 16 s
   (``sim_core.physics.drive_profiles.CubicSmoothstepSchedule``).
 * ``trapezoid``: the same duration (16 s), top speed and travel with constant accelerations:
   V (D - t_a) = travel gives t_a = 4 s, a = +-0.125 m/s^2.
@@ -32,7 +32,7 @@ import numpy as np
 
 from sim_core.physics.drive_profiles import CubicSmoothstepSchedule
 
-V_MAX = 0.5          # m/s, SCENARIOS A4
+V_MAX = 0.5          # m/s, docs/model.md#input-drive
 DURATION = 16.0      # s, end of the paper's cubic schedule
 TRAVEL = 6.0         # m, 2 -> 8 m
 
@@ -58,7 +58,7 @@ class RateSchedule:
 
 def cubic(v_max: float = V_MAX, t_ramp: float = 4.0, t_hold_end: float = 12.0,
           sign: int = 1) -> RateSchedule:
-    """The paper's smoothstep schedule (Zhao-Qi-Wang 2024 Sec. 9; SCENARIOS A4)."""
+    """The paper's smoothstep schedule (Zhao-Qi-Wang 2024 Sec. 9; docs/model.md#input-drive)."""
     s = CubicSmoothstepSchedule(v_max=v_max, t_ramp=t_ramp, t_hold_end=t_hold_end, sign=sign)
     return RateSchedule("cubic", lambda t: float(s.rate(t)), s.t_end)
 

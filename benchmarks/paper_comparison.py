@@ -172,7 +172,8 @@ def extraction_rows(res: Result) -> list[Row]:
     rows = []
     F0 = Ft[0]
     rows.append(Row("27", "Telescopic-cylinder force starts at the static value m2 g sin(theta) "
-                    "+ 2 T of the frictionless rigid boom (SCENARIOS C7)",
+                    "+ 2 T of the frictionless rigid boom "
+                    "([check: static luffing](model.md#check-static-luffing))",
                     f"{F0 / 1e6:.4f} MN vs {stat.telescopic_force / 1e6:.4f} MN",
                     ok(abs(F0 / stat.telescopic_force - 1) < 0.02)))
     sm = smooth(t, Ft)
@@ -197,7 +198,9 @@ def extraction_rows(res: Result) -> list[Row]:
     g = luffing_geometry(THETA)
     stat16 = static_luffing_forces(THETA, 8.0, mp)
     rows.append(Row("27", "Luffing-cylinder force at t = 0 from the printed geometry (lever "
-                    f"{g.lever:.3f} m about D1 at 60 deg; SCENARIOS A2, C7)",
+                    f"{g.lever:.3f} m about D1 at 60 deg; "
+                    "[inputs: luffing](model.md#input-luffing), "
+                    "[check: static luffing](model.md#check-static-luffing))",
                     f"{Fl[0] / 1e6:.3f} MN vs {stat.luffing_force / 1e6:.3f} MN (rigid statics)",
                     ok(abs(Fl[0] / stat.luffing_force - 1) < 0.02)))
     sl = smooth(t, Fl)
@@ -527,12 +530,14 @@ def report(results: dict, img: Path, report_path: Path, quick: bool,
         "",
         "## The luffing-cylinder force",
         "",
-        "The printed coordinates of D1, D2, D3 (SCENARIOS A2) put the luffing cylinder's line "
+        "The printed coordinates of D1, D2, D3 ([inputs: luffing](model.md#input-luffing)) put "
+        "the luffing cylinder's line "
         f"{luffing_geometry(THETA).lever:.3f} m from the pivot D1 at 60 deg. With that lever the "
         "moment of the booms and the 25 t payload about D1 needs "
         f"{static_luffing_forces(THETA, 2.0, 25000.0).luffing_force / 1e6:.2f} MN at L_s = 2 m "
         f"and {static_luffing_forces(THETA, 8.0, 25000.0).luffing_force / 1e6:.2f} MN at "
-        "L_s = 8 m (rigid statics, SCENARIOS C7), and the dynamic runs agree with it at t = 0 "
+        "L_s = 8 m (rigid statics, [check: static luffing](model.md#check-static-luffing)), and "
+        "the dynamic runs agree with it at t = 0 "
         "(rows above). A lever below 0.72 m (|D1 D2|) is short for a crane of this size, and "
         "the rotation matrix of the printed equation lost its signs, so this reading is "
         "uncertain: it follows the printed numbers, and the force scales with 1/lever if the "

@@ -15,8 +15,8 @@ Writes benchmarks/results/work_precision_beam.csv, work_precision_telescopic.csv
 log-log PNGs work_precision_beam.png, work_precision_telescopic.png (error vs wall seconds per
 simulated second).  ``--part beam`` / ``--part telescopic`` runs one part only.
 
-(a) Beam, SCENARIOS C3: force P crossing a simply supported 10 m steel beam at speed
-    c = alpha w1 L / pi (alpha = c/c_crit = 0.5).  Error = max over 41 output times of the
+(a) Beam, docs/model.md#check-moving-load: force P crossing a simply supported 10 m steel beam
+    at speed c = alpha w1 L / pi (alpha = c/c_crit = 0.5).  Error = max over 41 output times of the
     midspan deflection error (m) against Fryba's series (sim_core.validation.closed_form,
     Fryba 1972 Ch. 1, 31 terms) AND against a converged reference (quick: 8 sub-elements,
     RK45 rtol 1e-7, filter h = 0.3 ms; full: 16 sub-elements, rtol 1e-9, h = 0.1 ms; the
@@ -71,7 +71,7 @@ FIELDS = ["case", "integrator", "n_sub", "rtol", "filter_h", "t_sim", "status", 
           "wall_per_sim_s", "n_steps", "n_evals", "n_jac", "n_rejected", "err_closed_m",
           "err_ref_m", "peak_m"]
 
-# -- beam (SCENARIOS C3) ---------------------------------------------------------------------
+# -- beam (docs/model.md#check-moving-load) --------------------------------------------------
 E, G_MOD, RHO, L = 2.1e11, 8.0e10, 7850.0, 10.0
 A, I_T, I_B = 1e-2, 1e-5, 1.3e-5
 P_LOAD = 500.0          # N; static midspan deflection P L^3/(48 EI) = 5.0 mm

@@ -46,7 +46,7 @@ velocity jump dv gives the modal velocity jump dq' = -Gamma dv of q'' = -Gamma a
 Action space
 ------------
 ``Box(-1, 1, (1,), float32)``: commanded cylinder acceleration a = action * a_max (m/s^2),
-a_max = 0.25 m/s^2 by default (the paper's cubic schedule, SCENARIOS A4, peaks at
+a_max = 0.25 m/s^2 by default (the paper's cubic schedule, docs/model.md#input-drive, peaks at
 1.5 * 0.5 / 4 = 0.1875 m/s^2).  Non-finite actions raise ValueError; finite actions outside
 [-1, 1] are clipped.
 
@@ -188,7 +188,7 @@ from sim_core.errors import SimulationError
 from sim_core.systems.telescopic.modal import TABLE_BOOMS, ModalROM, allowed_ranges, tables_for
 from sim_core.validation.closed_form import luffing_geometry
 
-BOOM_LENGTH = 10.0          # m, SCENARIOS A1
+BOOM_LENGTH = 10.0          # m, docs/model.md#input-sections
 BOOMS = tuple(TABLE_BOOMS)  # boom counts with modal tables: 3 (the paper's), 5
 DEFAULT_PAYLOAD = {3: 25000.0, 5: 10000.0}   # kg: the paper scene's; the 5-section scenes'
 # deflection scales of the reward and the success test for three booms (m, m/s); five booms

@@ -150,9 +150,18 @@ def cmd_list(args) -> int:
 
 def cmd_describe(args) -> int:
     scene = load_scene(args.scene, _overrides(args.set))
+    kind = system_kind(scene)
+    if args.json:
+        # one JSON object: the resolved scene and, where the kind computes them, its derived
+        # properties (telescopic: every boom's section constants and the luffing lever)
+        out = {"scene": {k: v for k, v in scene.items() if k != "source"}}
+        if hasattr(kind, "properties"):
+            out.update(kind.properties(scene))
+        print(json.dumps(out, indent=2))
+        return 0
     print(f"scene {scene['name']}: {scene['description']}")
     print("effects: " + ", ".join(f"{k}={'on' if v else 'off'}" for k, v in scene["effects"].items()))
-    for line in system_kind(scene).describe(scene):
+    for line in kind.describe(scene):
         print(line)
     print(json.dumps({k: v for k, v in scene.items() if k != "source"}, indent=2))
     return 0
@@ -264,6 +273,9 @@ def main(argv: list[str] | None = None) -> int:
     d = sub.add_parser("describe", help="resolved scene, effects and DOF count")
     d.add_argument("scene")
     d.add_argument("--set", action="append", metavar="KEY=VALUE")
+    d.add_argument("--json", action="store_true",
+                   help="print one JSON object: the resolved scene and its derived properties "
+                        "(telescopic: every boom's section constants, the luffing lever)")
     d.set_defaults(func=cmd_describe)
     pl = sub.add_parser("plot", help="figures from a result file")
     pl.add_argument("result")

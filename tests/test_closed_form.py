@@ -1,4 +1,5 @@
-"""Tests of sim_core.validation.closed_form against independent numerics and SCENARIOS numbers."""
+"""Tests of sim_core.validation.closed_form against independent numerics and the numbers of
+docs/model.md#inputs-and-decisions."""
 
 from __future__ import annotations
 
@@ -16,7 +17,7 @@ from sim_core.validation import closed_form as cf
 TH = math.radians(60.0)
 
 
-# ----------------------------------------------------------------------------- C1
+# ----------------------------------------------------- docs/model.md#check-cantilever-statics
 def test_cantilever_statics_by_quadrature():
     P, q, L, EI = 1.2e4, 3.1e3, 10.0, 7.22e8
     for res, M in ((cf.cantilever_tip_load(P, L, EI), lambda x: P * (L - x)),
@@ -27,7 +28,7 @@ def test_cantilever_statics_by_quadrature():
         assert res.deflection == pytest.approx(defl, rel=1e-12)
 
 
-# ----------------------------------------------------------------------------- C2
+# ------------------------------------------------- docs/model.md#check-cantilever-frequencies
 def test_cantilever_roots_and_frequencies():
     b = cf.cantilever_beta_L(3)
     np.testing.assert_allclose(b, [1.8751, 4.6941, 7.8548], atol=6e-5)
@@ -53,7 +54,7 @@ def test_fixed_free_bar_against_finite_differences():
     assert cf.fixed_free_torsion_f1(4.0, 1.0, 0.25) == pytest.approx(2.0)
 
 
-# ----------------------------------------------------------------------------- C3
+# ------------------------------------------------------------ docs/model.md#check-moving-load
 @pytest.mark.parametrize("alpha", [0.1, 0.3, 0.5])
 def test_fryba_series_equals_modal_ode(alpha):
     P, L, EI, m, n = 1.0e5, 20.0, 8.39e7, 544.6, 15
@@ -94,7 +95,7 @@ def test_fryba_quasistatic_limit_and_errors():
         cf.fryba_deflection(L / 2, 0.0, P, c, L, -1.0, m)
 
 
-# ----------------------------------------------------------------------------- C4
+# ----------------------------------------------------------------- docs/model.md#check-sleeve
 def test_bigoni_sleeve_energy_release():
     P, EI, ell = 50.0, 2.0e3, 1.3
     r = cf.bigoni_sleeve(P, ell, EI)
@@ -110,7 +111,7 @@ def test_bigoni_sleeve_energy_release():
     assert r.configurational_force == pytest.approx(release, rel=1e-7)
 
 
-# ----------------------------------------------------------------------------- A2 geometry
+# ------------------------------------------------------ geometry, docs/model.md#input-luffing
 def test_luffing_geometry_matches_scenarios():
     g = cf.luffing_geometry(TH)
     assert g.cylinder_length == pytest.approx(8.147, abs=5e-4)
@@ -130,7 +131,7 @@ def test_top_centre_start_points():
     assert cf.boom3_top_centre(TH, np.array([2.0, 5.0, 8.0])).shape == (3, 2)
 
 
-# ----------------------------------------------------------------------------- A9
+# ------------------------------------------------------------ docs/model.md#input-rigid-limit
 @pytest.mark.parametrize("sign, Ls0", [(1, 2.0), (-1, 8.0)])
 def test_rigid_tip_kinematics(sign, Ls0):
     sch = CubicSmoothstepSchedule(sign=sign, s0=Ls0)
@@ -149,7 +150,7 @@ def test_rigid_tip_kinematics(sign, Ls0):
     assert k.vz[80] == pytest.approx(sign * 2 * 0.5 * math.sin(TH))
 
 
-# ----------------------------------------------------------------------------- C7
+# --------------------------------------------------------- docs/model.md#check-static-luffing
 def _potential(theta, Ls, mp, g=9.81):
     """Gravity potential of the rigid boom (independent: Z of each mass point)."""
     geo = cf.luffing_geometry(theta)

@@ -1,4 +1,5 @@
-"""Tests of sim_core.physics.drive_profiles (SCENARIOS A4 cubic schedule, B Eq. 52 profile)."""
+"""Tests of sim_core.physics.drive_profiles (cubic schedule of docs/model.md#input-drive, Eq. 52
+profile of docs/model.md#input-folding-drive)."""
 
 from __future__ import annotations
 

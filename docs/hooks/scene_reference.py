@@ -228,8 +228,9 @@ class _Walker(ast.NodeVisitor):
                 if re.fullmatch(r"\[[\w., ]*\]", text):          # e.g. [0.0, length]
                     self.out["gets"].setdefault(node.args[0].value, text)
         elif f is not None and f in self.funcs and (f == "solver_table" or f.startswith("_check")):
-            fn, mod_funcs, mod_consts = self.funcs[f]
-            sub = _Walker(self.modules, mod_funcs, mod_consts, self.out,
+            fn, _, mod_consts = self.funcs[f]
+            # the registry goes down with the walk, so a _check helper may call another
+            sub = _Walker(self.modules, self.funcs, mod_consts, self.out,
                           params=[a.arg for a in fn.args.args])
             for s in fn.body:
                 sub.visit(s)

@@ -82,9 +82,9 @@ class RefreshedJacobian:
     """BDF's Jacobian callable for one BDF stretch: the structured Jacobian, or -- when Newton
     fails with the one BDF has -- that Jacobian with its non-smooth columns refreshed.
 
-    The friction law mu(v) (SCENARIOS A6, the paper's mu sign(s_dot) of Eq. 65) is only C0 at
-    |v| = v_eps and its slope changes sign on the smoothstep branch; it enters the Jacobian
-    only through the columns of the contact coordinates' rates
+    The friction law mu(v) (docs/model.md#input-friction, the paper's mu sign(s_dot) of Eq. 65)
+    is only C0 at |v| = v_eps and its slope changes sign on the smoothstep branch; it enters the
+    Jacobian only through the columns of the contact coordinates' rates
     (:meth:`sim_core.model.model.Model.nonsmooth_rate_columns`).  When a contact crosses a branch
     those few columns jump while the rest changes smoothly with the state, and scipy's BDF,
     which asks for a new Jacobian whenever Newton fails with the one it has, got a whole one

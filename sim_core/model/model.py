@@ -795,9 +795,9 @@ class Model:
     def nonsmooth_rate_columns(self) -> np.ndarray:
         """Columns of the state Jacobian d(y')/dy, y = (z, z_dot), that carry a non-smooth
         rate law: the reduced rates the multiplier forces' velocity coordinates depend on
-        (friction: the contact coordinates' s_dot of Eq. 65, whose mu(v) of SCENARIOS A6 is
-        only C0 at |v| = v_eps).  Their velocity coordinates are fixed coordinate indices
-        (``velocity_coords`` does not read Q).  Used by
+        (friction: the contact coordinates' s_dot of Eq. 65, whose mu(v)
+        (docs/model.md#input-friction) is only C0 at |v| = v_eps).  Their velocity coordinates
+        are fixed coordinate indices (``velocity_coords`` does not read Q).  Used by
         :class:`sim_core.integrate.driver.RefreshedJacobian`; empty without such forces."""
         full = sorted({int(i) for mf in self.multiplier_forces
                        if hasattr(mf, "velocity_coords") for i in mf.velocity_coords(None)})
@@ -843,7 +843,8 @@ class Model:
             w = np.einsum("gin,n->gi", kin.J_w, qde)
             sec = el.section
             r = kin.r
-            if sec.has_offset:          # mass centre r + d (SCENARIOS A1), see effects
+            # mass centre r + d (docs/model.md#input-sections), see effects
+            if sec.has_offset:
                 d_glob = kin.sec.frame[:, 0] * sec.y_c + kin.sec.frame[:, 1] * sec.z_c
                 ws = w[:, [1, 2, 0]]    # (s, t, b) -> (t, b, s) body components
                 wxd = np.stack([-sec.z_c * ws[:, 2], sec.y_c * ws[:, 2],

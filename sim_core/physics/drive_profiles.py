@@ -4,9 +4,9 @@ Sources
 -------
 * ``CubicSmoothstepSchedule``: Zhao, Qi, Wang (2024), Section 9 (work conditions (1)/(2),
   Figs. 14/15: "cubic polynomial interpolation" of v with a = 0 at the ramp ends) as fixed in
-  design/SCENARIOS.md A4.  Default: 0.5 m/s, 4 s ramps, hold to 12 s, stop at 16 s, 6 m stroke.
+  docs/model.md#input-drive.  Default: 0.5 m/s, 4 s ramps, hold to 12 s, stop at 16 s, 6 m stroke.
 * ``Eq52Profile``: folding long-boom manipulator (SIMULTECH 2020), Eq. 52, as transcribed in
-  SCENARIOS.md B "Actuators": cubic rise, constant hold, *linear* decay (as printed).
+  docs/model.md#input-folding-drive: cubic rise, constant hold, *linear* decay (as printed).
 
 All methods accept a scalar or an array ``t`` (s) and return a float for scalar input, else an
 array of the same shape.  Strokes are the exact integrals of the rates (no quadrature).
@@ -101,7 +101,8 @@ class _PiecewiseProfile:
 class CubicSmoothstepSchedule(_PiecewiseProfile):
     """Smoothstep ramp-up / hold / mirrored ramp-down of the stroke rate.
 
-    Source: Zhao-Qi-Wang 2024 Section 9, Figs. 14/15; SCENARIOS.md A4.  With tau in [0, 1]:
+    Source: Zhao-Qi-Wang 2024 Section 9, Figs. 14/15; docs/model.md#input-drive.
+    With tau in [0, 1]:
       0 <= t < T:          v = V (3 tau^2 - 2 tau^3),      tau = t / T
       T <= t < t_h:        v = V
       t_h <= t < t_h + T:  v = V (1 - 3 tau^2 + 2 tau^3),  tau = (t - t_h) / T
@@ -136,13 +137,14 @@ class CubicSmoothstepSchedule(_PiecewiseProfile):
 
     @property
     def travel(self) -> float:
-        """Unsigned total stroke V * t_hold_end (SCENARIOS A4: 6 m), m."""
+        """Unsigned total stroke V * t_hold_end (docs/model.md#input-drive: 6 m), m."""
         return self.v_max * self.t_hold_end
 
     def _ramps(self, tu, td):
-        """(s, v, a, j) of the ramp-up at tau = tu and of the ramp-down at tau = td (A4;
-        Zhao-Qi-Wang Sec. 9): up v = V(3tau^2 - 2tau^3), s = V T (tau^3 - tau^4/2); down
-        mirrored, v = V(1 - 3tau^2 + 2tau^3), s = sh + V T (tau - tau^3 + tau^4/2)."""
+        """(s, v, a, j) of the ramp-up at tau = tu and of the ramp-down at tau = td
+        (docs/model.md#input-drive; Zhao-Qi-Wang Sec. 9): up v = V(3tau^2 - 2tau^3),
+        s = V T (tau^3 - tau^4/2); down mirrored, v = V(1 - 3tau^2 + 2tau^3),
+        s = sh + V T (tau - tau^3 + tau^4/2)."""
         V, T = self.v_max, self.t_ramp
         sh = 0.5 * V * T + V * (self.t_hold_end - T)
         up = (V * T * (tu**3 - 0.5 * tu**4), V * (3 * tu**2 - 2 * tu**3),
@@ -186,7 +188,8 @@ class CubicSmoothstepSchedule(_PiecewiseProfile):
 class Eq52Profile(_PiecewiseProfile):
     """Cubic rise / hold / linear decay of the actuator rate (second seed, Eq. 52).
 
-    Source: folding long-boom manipulator (SIMULTECH 2020) Eq. 52; SCENARIOS.md B "Actuators".
+    Source: folding long-boom manipulator (SIMULTECH 2020) Eq. 52;
+    docs/model.md#input-folding-drive.
     With t_a = t1, t_b = t1 + t2, t_c = t_b + t3 (relative to ``t_start``):
       0 <= t < t_a:     v = v0 t^2 (3 t1 - 2 t) / t1^3,  a = 6 v0 t (t1 - t) / t1^3
       t_a <= t < t_b:   v = v0,                          a = 0
@@ -222,7 +225,8 @@ class Eq52Profile(_PiecewiseProfile):
 
     @property
     def travel(self) -> float:
-        """Unsigned travel v0 (t1/2 + t2 + t3/2) (SCENARIOS B, Eq. 52 integral)."""
+        """Unsigned travel v0 (t1/2 + t2 + t3/2) (docs/model.md#input-folding-drive, Eq. 52
+        integral)."""
         return self.v0 * (0.5 * self.t1 + self.t2 + 0.5 * self.t3)
 
     def _unit(self, tl: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -250,9 +254,10 @@ def sleeve_motion(bc: dict, s0: float = 0.0):
     """t -> (s, s_dot, s_ddot) of a sleeve end's material coordinate (m, m/s, m/s^2) from its
     validated ``[[boundary]]`` entry (sim_core.scene.io): profile "constant" moves at ``speed``
     from t = 0, s = s0 + speed t; profile "cubic" follows the telescopic drive's schedule of
-    Zhao-Qi-Wang 2024 Section 9 (:class:`CubicSmoothstepSchedule`, SCENARIOS A4) with peak rate
-    ``speed`` (its sign the direction), ramps of ``t_ramp`` and the hold up to ``t_hold_end``.
-    Either motion is monotone in t, so its extreme over [0, t_end] is at t_end."""
+    Zhao-Qi-Wang 2024 Section 9 (:class:`CubicSmoothstepSchedule`, docs/model.md#input-drive)
+    with peak rate ``speed`` (its sign the direction), ramps of ``t_ramp`` and the hold up to
+    ``t_hold_end``.  Either motion is monotone in t, so its extreme over [0, t_end] is at
+    t_end."""
     v = float(bc["speed"])
     if bc.get("profile", "constant") == "constant" or v == 0.0:
         return lambda t: (s0 + v * t, v, 0.0)

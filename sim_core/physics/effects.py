@@ -68,8 +68,8 @@ def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def _offset_jacobian(ctx: ElementContext) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Mass-centre offset d = y_c e_t + z_c e_b (SCENARIOS A1: rigid offset of the mass centre
-    from the reference line, paper Table 2).  Returns (J_c, frame, d_body):
+    """Mass-centre offset d = y_c e_t + z_c e_b (docs/model.md#input-sections: rigid offset of
+    the mass centre from the reference line, paper Table 2).  Returns (J_c, frame, d_body):
 
     J_c = J_r + frame^T C J_w, the velocity Jacobian of the mass centre r + d, where C maps the
     section-frame angular velocity (omega_s, omega_t, omega_b) to omega x d in (e_t, e_b, e_s)
@@ -121,8 +121,8 @@ class Inertia(Effect):
         Jd = sec.J
         J_w = kin.J_w
         if sec.has_offset:
-            # mass centre offset from the reference line (SCENARIOS A1 / paper Table 2): the
-            # translational terms use the mass-centre Jacobian and acceleration
+            # mass centre offset from the reference line (docs/model.md#input-sections / paper
+            # Table 2): the translational terms use the mass-centre Jacobian and acceleration
             J_r, frame, d = _offset_jacobian(ctx)
         else:
             J_r = kin.J_r
@@ -197,7 +197,8 @@ class Gravity(Effect):
         self.g = np.asarray(g, dtype=float)
 
     def element_terms(self, ctx, M, F):
-        # weight at the mass centre: with an offset (SCENARIOS A1) the mass-centre Jacobian
+        # weight at the mass centre: with an offset (docs/model.md#input-sections) the mass-centre
+        # Jacobian
         J = _offset_jacobian(ctx)[0] if ctx.el.section.has_offset else ctx.kin.J_r
         F += _jt_v(J, (ctx.wl * ctx.el.section.rhoA)[:, None] * self.g)
 

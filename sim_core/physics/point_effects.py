@@ -52,10 +52,10 @@ class PointMass:
 
 @dataclass
 class RopeDrive:
-    """Elastic, massless, tension-only rope over frictionless point pulleys (Section 9; SCENARIOS
-    A3): length l(Q) = sum |r_{i+1} - r_i| over anchor, pulleys, anchor; tension
-    T = (EA/L0) * ramp(l - L0) with a C1 ramp over ``slack_width`` (m) so the switch to slack is
-    smooth; generalized force F -= T dl/dQ."""
+    """Elastic, massless, tension-only rope over frictionless point pulleys (Section 9;
+    docs/model.md#input-ropes): length l(Q) = sum |r_{i+1} - r_i| over anchor, pulleys, anchor;
+    tension T = (EA/L0) * ramp(l - L0) with a C1 ramp over ``slack_width`` (m) so the switch to
+    slack is smooth; generalized force F -= T dl/dQ."""
 
     points: Sequence[Callable]
     EA: float

@@ -400,7 +400,8 @@ def cylinder_inertia(m: float, radius: float, length: float) -> np.ndarray:
 
 @dataclass
 class SpringDamperActuator:
-    """Hydraulic cylinder as a spring-damper on the pin distance s (SCENARIOS B, PD):
+    """Hydraulic cylinder as a spring-damper on the pin distance s (PD,
+    docs/model.md#input-folding-drive):
 
         F = k (s - s_ref(t)) + c (s_dot - v(t)),  s_ref = s_ref0 + int_0^t v dt
 

@@ -1,26 +1,33 @@
-"""Closed-form reference solutions (SI units) for the validation cases of design/SCENARIOS.md.
+"""Closed-form reference solutions (SI units) for the checks of docs/model.md#checks.
 
 Sources
 -------
-* C1 cantilever statics, C2 cantilever/bar frequencies: Euler-Bernoulli beam theory
-  (e.g. Timoshenko & Gere; Blevins, "Formulas for natural frequency and mode shape").
-* C3 moving force on a simply supported beam: Fryba, "Vibration of Solids and Structures under
-  Moving Loads" (1972), Ch. 1, series exactly as transcribed in SCENARIOS C3.
-* C4 rod through a frictionless sleeve: Bigoni, Dal Corso, Bosi, Misseroni, "Eshelby-like forces
-  acting on elastic structures", J. Mech. Phys. Solids 2015 (configurational force M^2/(2EI)).
-* A9 / C6 rigid-limit tip kinematics: Zhao-Qi-Wang 2024, Section 9.1, Eqs. 74-76.
-* A2 luffing geometry and C7 static forces: Zhao-Qi-Wang 2024, Section 9 (Fig. 13a, the L_h
-  equation and rotation R) with the proposed-default signs of SCENARIOS A2.
+* cantilever statics (docs/model.md#check-cantilever-statics), cantilever/bar frequencies
+  (docs/model.md#check-cantilever-frequencies): Euler-Bernoulli beam theory (e.g. Timoshenko &
+  Gere; Blevins, "Formulas for natural frequency and mode shape").
+* moving force on a simply supported beam (docs/model.md#check-moving-load): Fryba, "Vibration
+  of Solids and Structures under Moving Loads" (1972), Ch. 1, series exactly as written on
+  that page.
+* rod through a frictionless sleeve (docs/model.md#check-sleeve): Bigoni, Dal Corso, Bosi,
+  Misseroni, "Eshelby-like forces acting on elastic structures", J. Mech. Phys. Solids 2015
+  (configurational force M^2/(2EI)).
+* rigid-limit tip kinematics (docs/model.md#input-rigid-limit, docs/model.md#check-rigid-limit):
+  Zhao-Qi-Wang 2024, Section 9.1, Eqs. 74-76.
+* luffing geometry (docs/model.md#input-luffing) and static forces
+  (docs/model.md#check-static-luffing): Zhao-Qi-Wang 2024, Section 9 (Fig. 13a, the L_h
+  equation and rotation R) with the proposed-default signs of docs/model.md#input-luffing.
 
-Frames (SCENARIOS A1/A2): global X forward, Z up, Y = Z x X.  Boom-1 left-section components are
-(axial e_s, lateral e_t, e_b); at theta = 0 they coincide with (X, Y, Z).  PD rotation
-R(theta) = [[cos, 0, -sin], [0, 1, 0], [sin, 0, cos]] maps them to global; theta > 0 lifts the tip.
+Frames (docs/model.md#input-luffing): global X forward, Z up, Y = Z x X.  Boom-1 left-section
+components are (axial e_s, lateral e_t, e_b); at theta = 0 they coincide with (X, Y, Z).  PD
+rotation R(theta) = [[cos, 0, -sin], [0, 1, 0], [sin, 0, cos]] maps them to global; theta > 0
+lifts the tip.
 
-"Top centre of boom 3" (A8/A9): the paper calls the right-end section the *top* section (B1, B3
-are given "relative to the top cross-sections").  Its *centre* is the section-frame origin, i.e.
-the centre of the lower half circle = the beam reference line (A1), at material coordinate
-s = boom_length of boom 3, whose left section lies 2 L_s along boom 1's axis (A3).  This
-reproduces the quoted start points (7.404, 13.024) m (L_s = 2 m) and (13.404, 23.417) m (8 m).
+"Top centre of boom 3" (docs/model.md#input-outputs): the paper calls the right-end section the
+*top* section (B1, B3 are given "relative to the top cross-sections").  Its *centre* is the
+section-frame origin, i.e. the centre of the lower half circle = the beam reference line
+(docs/model.md#input-sections), at material coordinate s = boom_length of boom 3, whose left
+section lies 2 L_s along boom 1's axis (docs/model.md#input-ropes).  This reproduces the quoted
+start points (7.404, 13.024) m (L_s = 2 m) and (13.404, 23.417) m (8 m).
 """
 
 from __future__ import annotations
@@ -35,7 +42,7 @@ from scipy.optimize import brentq
 from sim_core.errors import SceneError
 from sim_core.physics.drive_profiles import ArrayLike, DriveProfile
 from sim_core.systems.telescopic.luffing import (  # noqa: F401  (re-exported: the reference
-    R1_DEFAULT,  # geometry of A2)
+    R1_DEFAULT,  # geometry of docs/model.md#input-luffing)
     R2_DEFAULT,
     RBAR1_DEFAULT,
     RBAR3_DEFAULT,
@@ -44,7 +51,8 @@ from sim_core.systems.telescopic.luffing import (  # noqa: F401  (re-exported: t
     luffing_rotation,
 )
 
-# --- A1 Table 2: mass per length (kg/m) and mass-centre offset z_c along e_b (m), booms 1..3.
+# --- Table 2 (docs/model.md#input-sections): mass per length (kg/m) and mass-centre offset z_c
+# along e_b (m), booms 1..3.
 M_PER_LENGTH_DEFAULT = (318.86, 304.07, 289.27)
 Z_C_DEFAULT = (0.045, 0.044, 0.043)
 
@@ -57,7 +65,7 @@ def _pos(name: str, value: float) -> float:
     return v
 
 
-# ----------------------------------------------------------------------------- C1 statics
+# ---------------------------- cantilever statics (docs/model.md#check-cantilever-statics)
 @dataclass(frozen=True)
 class TipResponse:
     """Cantilever tip deflection (m, along the load) and tip slope (rad)."""
@@ -78,7 +86,7 @@ def cantilever_uniform_load(q: float, L: float, EI: float) -> TipResponse:
     return TipResponse(q * L**4 / (8 * EI), q * L**3 / (6 * EI))
 
 
-# ----------------------------------------------------------------------------- C2 frequencies
+# ------------------------------- frequencies (docs/model.md#check-cantilever-frequencies)
 def cantilever_beta_L(n_modes: int = 3) -> np.ndarray:
     """Roots beta_n L of the clamped-free frequency equation 1 + cos x cosh x = 0 (brentq).
 
@@ -134,12 +142,12 @@ def fixed_free_torsion_f1(GJ: float, J_s: float, L: float) -> float:
     return math.sqrt(_pos("GJ", GJ) / _pos("J_s", J_s)) / (4 * _pos("L", L))
 
 
-# ----------------------------------------------------------------------------- C3 Fryba
+# ------------------------------------------------ Fryba (docs/model.md#check-moving-load)
 def fryba_deflection(x: ArrayLike, t: ArrayLike, P: float, c: float, L: float, EI: float,
                      m: float, n_terms: int = 50) -> np.ndarray:
     """Deflection w(x, t) (m, along P) of a simply supported beam under a force P (N) moving
     at speed c (m/s) from x = 0 at t = 0, zero initial state, valid for 0 <= t <= L/c
-    (SCENARIOS C3; the sum runs over j = 1..n_terms):
+    (docs/model.md#check-moving-load; the sum runs over j = 1..n_terms):
 
         w = w0 sum_j [sin(j w t) - (alpha/j) sin(w_j t)] sin(j pi x/L) / (j^2 (j^2 - alpha^2)),
         w0 = 2 P L^3/(pi^4 EI),  w = pi c/L,  w_j = j^2 (pi/L)^2 sqrt(EI/m),  alpha = w/w_1.
@@ -171,7 +179,7 @@ def fryba_deflection(x: ArrayLike, t: ArrayLike, P: float, c: float, L: float, E
     return w0 * terms.sum(axis=-1)
 
 
-# ----------------------------------------------------------------------------- C4 sleeve
+# ---------------------------------------------------- sleeve (docs/model.md#check-sleeve)
 @dataclass(frozen=True)
 class SleeveReference:
     """Bigoni et al. 2015: tip deflection (m), clamp moment M = P l (N m), and configurational
@@ -193,7 +201,8 @@ def boom3_top_centre(theta: float, L_s: ArrayLike, boom_length: float = 10.0,
                      **geometry: Sequence[float]) -> np.ndarray:
     """Global (X, Z) of the top centre of boom 3 in the rigid state (m), shape (..., 2).
 
-    Reference-line point of boom 3's right-end section: O + (2 L_s + boom_length) e_s (A1-A3).
+    Reference-line point of boom 3's right-end section: O + (2 L_s + boom_length) e_s
+    (docs/model.md#input-sections, docs/model.md#input-ropes).
     ``geometry`` forwards r1, r2, rbar1, rbar3 to ``luffing_geometry``.
     """
     g = luffing_geometry(theta, **geometry)
@@ -202,7 +211,7 @@ def boom3_top_centre(theta: float, L_s: ArrayLike, boom_length: float = 10.0,
     return p[..., [0, 2]]
 
 
-# ----------------------------------------------------------------------------- A9 / C6
+# ------------------------------------------ rigid limit (docs/model.md#input-rigid-limit)
 @dataclass(frozen=True)
 class TipKinematics:
     """Rigid-limit top-centre position (m), velocity (m/s), acceleration (m/s^2), X and Z."""
@@ -217,7 +226,8 @@ class TipKinematics:
 
 def rigid_tip_kinematics(t: ArrayLike, schedule: DriveProfile, theta: float,
                          r0: Sequence[float]) -> TipKinematics:
-    """Zhao-Qi-Wang 2024 Eqs. 74-76 (SCENARIOS A9): boom 3 moves twice the piston stroke.
+    """Zhao-Qi-Wang 2024 Eqs. 74-76 (docs/model.md#input-rigid-limit): boom 3 moves twice the
+    piston stroke.
 
     r = r0 + 2 s0(t) (cos th, sin th), v = 2 v(t) (cos th, sin th), a = 2 a(t) (cos th, sin th),
     with s0(t) = schedule.stroke(t) - schedule.s0 (signed; a retraction schedule with sign = -1
@@ -231,10 +241,10 @@ def rigid_tip_kinematics(t: ArrayLike, schedule: DriveProfile, theta: float,
                          2 * a * ct, 2 * a * st)
 
 
-# ----------------------------------------------------------------------------- C7 statics
+# ------------------------------------------- statics (docs/model.md#check-static-luffing)
 @dataclass(frozen=True)
 class StaticLuffingForces:
-    """Rigid static forces at t = 0 (SCENARIOS C7), N and N m.
+    """Rigid static forces at t = 0 (docs/model.md#check-static-luffing), N and N m.
 
     luffing_force: cylinder force, > 0 = compression (pushes D3 away from D2);
     gravity_moment: moment of all weights about D1 (global Y component; > 0 lowers the tip);
@@ -255,7 +265,8 @@ def static_luffing_forces(theta: float, L_s: float, payload_mass: float, *,
                           m_per_length: Sequence[float] = M_PER_LENGTH_DEFAULT,
                           z_c: Sequence[float] = Z_C_DEFAULT, boom_length: float = 10.0,
                           g: float = 9.81, **geometry: Sequence[float]) -> StaticLuffingForces:
-    """Static luffing-cylinder, rope and telescopic forces of the rigid boom (SCENARIOS C7).
+    """Static luffing-cylinder, rope and telescopic forces of the rigid boom
+    (docs/model.md#check-static-luffing).
 
     Moments about D1 (global Y): boom k of mass m_k = boom_length m'_k at axial a_k + boom_length/2
     (a_k = 0, L_s, 2 L_s, m, along boom 1 from its left section) offset z_c[k] along e_b; payload

@@ -77,7 +77,8 @@ def test_zv_impulses_sum_to_one_and_delay_half_period():
 
 def test_force_at_rest_is_the_static_closed_form():
     """At rest (q = 0, a = 0) the evaluation's telescopic force is the rigid static force of
-    SCENARIOS C7 (closed_form.static_luffing_forces, independent code path, z_c = 0)."""
+    docs/model.md#check-static-luffing (closed_form.static_luffing_forces, independent code
+    path, z_c = 0)."""
     env = ev.make_eval_env()
     env.reset(seed=0)
     u = env.unwrapped

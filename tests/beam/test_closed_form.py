@@ -1,4 +1,5 @@
-"""Closed-form validation of the beam (SCENARIOS part C1, C2) and a refinement study."""
+"""Closed-form validation of the beam (docs/model.md#check-cantilever-statics,
+docs/model.md#check-cantilever-frequencies) and a refinement study."""
 
 import numpy as np
 import pytest
@@ -23,8 +24,9 @@ def _solve_static(m, Q0):
 
 
 def test_cantilever_tip_load():
-    """w = PL^3/(3EI), slope PL^2/(2EI) (C1); deflection/L = 1e-4, so geometric nonlinearity is
-    O(1e-8) and the 0.5 % tolerance of C1 is far above it."""
+    """w = PL^3/(3EI), slope PL^2/(2EI) (docs/model.md#check-cantilever-statics);
+    deflection/L = 1e-4, so geometric nonlinearity is O(1e-8) and the 0.5 % tolerance of that
+    check is far above it."""
     P = -1e3 * 0.1
     m, Q0 = cantilever(loads=[PointLoad(0, lambda t: L, lambda t: np.array([0.0, 0.0, P]))])
     Q = _solve_static(m, Q0)
@@ -54,7 +56,8 @@ def cantilever_modes():
 
 
 def test_cantilever_bending_frequencies(cantilever_modes):
-    """First three bending frequencies in both planes (C2; Euler-Bernoulli, no rotary inertia)."""
+    """First three bending frequencies in both planes (docs/model.md#check-cantilever-frequencies;
+    Euler-Bernoulli, no rotary inertia)."""
     w = cantilever_modes
     m_ = RHO * A
     for EI in (E * I_T, E * I_B):

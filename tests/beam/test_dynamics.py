@@ -1,4 +1,4 @@
-"""Dynamic validation: Fryba's moving force (SCENARIOS C3)."""
+"""Dynamic validation: Fryba's moving force (docs/model.md#check-moving-load)."""
 
 import numpy as np
 import pytest
@@ -48,8 +48,9 @@ def test_fryba_moving_force_midspan(alpha):
 @pytest.mark.slow
 def test_free_vibration_energy_conserved_to_solver_tolerance():
     """Undamped, unfiltered free vibration from a statically deflected (bent and twisted) shape
-    of a stocky cantilever: T + U constant (SCENARIOS C5).  The drift over one period is below
-    1e-4 of U_0 and shrinks as rtol is tightened (measured 1.3e-7 at rtol 1e-5, 1.5e-9 at 1e-7).
+    of a stocky cantilever: T + U constant (docs/model.md#check-energy).  The drift over one
+    period is below 1e-4 of U_0 and shrinks as rtol is tightened (measured 1.3e-7 at rtol 1e-5,
+    1.5e-9 at 1e-7).
     Explicit RK45 is stiffness-limited here (highest mode ~350 x the first), hence `slow`."""
     from scipy.integrate import solve_ivp
 

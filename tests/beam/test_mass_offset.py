@@ -1,5 +1,5 @@
-"""Mass-centre offset from the reference line (paper Table 2 z_c; SCENARIOS A1: a rigid offset in
-inertia and gravity, stiffness on the reference line)."""
+"""Mass-centre offset from the reference line (paper Table 2 z_c; docs/model.md#input-sections:
+a rigid offset in inertia and gravity, stiffness on the reference line)."""
 
 import math
 

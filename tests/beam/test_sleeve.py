@@ -1,4 +1,4 @@
-"""A beam drawn through a rigid frictionless point sleeve (SCENARIOS C4).
+"""A beam drawn through a rigid frictionless point sleeve (docs/model.md#check-sleeve).
 
 The sleeve exit is a fixed spatial point; the element's end node sits there and its material
 coordinate s_1(t) is prescribed: material flows through the node (Section 3).
@@ -52,7 +52,8 @@ def test_axial_drawing_without_load_is_a_rigid_flow():
 def test_tip_load_deflection_and_configurational_force(s1):
     """Quasi-static tip load P at free length l = 12 - s_1: tip deflection P l^3/(3EI) and the
     axial force needed to hold the rod in the sleeve = M^2/(2EI), M = P l (Bigoni et al. 2015).
-    Deflection/l ~ 1e-3 keeps geometric nonlinearity below 1e-3; tolerance 2 % (C4)."""
+    Deflection/l ~ 1e-3 keeps geometric nonlinearity below 1e-3; tolerance 2 %
+    (docs/model.md#check-sleeve)."""
     P = -50.0
     sc = _scene(**{"point_loads.0.force": [0.0, 0.0, P], "beams.0.breakpoints": [s1, 12.0],
                    "beams.0.origin": [-s1, 0.0, 0.0], "boundary.0.speed": 0.0})
@@ -72,7 +73,8 @@ def test_tip_load_deflection_and_configurational_force(s1):
 
 
 def test_energy_balance_of_the_open_domain():
-    """Tip-loaded rod pushed out at 0.5 m/s (SCENARIOS C4): the energy of the modelled domain,
+    """Tip-loaded rod pushed out at 0.5 m/s (docs/model.md#check-sleeve): the energy of the
+    modelled domain,
     E = T + U - P . r_tip, changes by the work of the sleeve's axial reaction (eta s_dot) plus the
     kinetic energy carried in by the material leaving the sleeve (rho A v^2 / 2 per metre):
     dE = int eta s_dot dt + rho A v^3 t / 2 to 1e-3 of dE.  Generalized-alpha with rho_inf = 1

@@ -1,9 +1,10 @@
 """A sleeve end driven by the telescopic drive's cubic schedule (boundary.profile = "cubic").
 
 The sleeve of a beam scene takes the same drive profiles as the telescopic cylinder
-(Zhao-Qi-Wang 2024 Section 9, SCENARIOS A4; drive_profiles.sleeve_motion): "constant" moves at
-``speed`` from t = 0, "cubic" ramps the rate up over t_ramp by a smoothstep, holds it to
-t_hold_end and ramps it down, so the travel by the end of the motion is speed * t_hold_end.
+(Zhao-Qi-Wang 2024 Section 9, docs/model.md#input-drive; drive_profiles.sleeve_motion):
+"constant" moves at ``speed`` from t = 0, "cubic" ramps the rate up over t_ramp by a smoothstep,
+holds it to t_hold_end and ramps it down, so the travel by the end of the motion is
+speed * t_hold_end.
 """
 
 import numpy as np

@@ -1,4 +1,5 @@
-"""The radial gap sets the contact circle of the sliding blocks (SCENARIOS A1/A6)."""
+"""The radial gap sets the contact circle of the sliding blocks (docs/model.md#input-sections,
+docs/model.md#input-springs)."""
 
 import pytest
 

@@ -67,7 +67,8 @@ def test_mass_matches_table2_with_midline_reading(k):
     # radii; printed to 0.01 kg/m, so the tolerance is the rounding half-unit (+ float slack).
     m_table = PAPER_TABLE2[k][2]
     assert props(k, "midline").mass_per_length == pytest.approx(m_table, abs=0.006)
-    # ... and the PD EA = E m'/rho is exactly that reading's EA (3 printed digits in the note)
+    # ... and the PD EA = E m'/rho is exactly that reading's EA (3 printed digits in
+    # docs/model.md#input-sections)
     assert props(k, "midline").EA == pytest.approx(E * m_table / RHO, rel=1e-4)
 
 
@@ -123,7 +124,8 @@ def test_mass_centre_vs_table2(k):
 
 
 def test_design_note_thin_wall_values_boom1():
-    # SCENARIOS.md A1: thin-wall calculation gives EI ~ 7.0-7.1e8, z_c ~ 0.044, rho A ~ 313
+    # docs/model.md#input-sections: thin-wall calculation gives EI ~ 7.0-7.1e8, z_c ~ 0.044,
+    # rho A ~ 313
     p = props(1, method="midline")
     assert 6.9e8 < p.EI_t < 7.15e8 and 6.9e8 < p.EI_b < 7.15e8
     assert p.z_c == pytest.approx(0.044, abs=6e-4)

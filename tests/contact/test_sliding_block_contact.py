@@ -1,4 +1,5 @@
-"""Tests of sim_core.physics.contact.sliding_block_contact (paper Section 8.2-8.3, SCENARIOS A6).
+"""Tests of sim_core.physics.contact.sliding_block_contact (paper Section 8.2-8.3,
+docs/model.md#input-springs).
 
 Each test checks a physical or mathematical fact; every tolerance is derived in a comment.
 Loads are of the order of the paper's 25 t case (region forces 1e5-1e6 N, moments 1e5 N m).
@@ -26,7 +27,7 @@ from sim_core.physics.contact import _sliding_block_contact_numba as micro_motio
 
 RTOL_SOLVE = 1e-11     # solver default: max |S R| <= 1e-11 max |S c|
 EQ_TOL = 1e-9          # brief: equations satisfied to 1e-9 relative (100x margin on RTOL_SOLVE)
-SPRING = SpringLaw()   # SCENARIOS A6 defaults k0 = 1e9 N/m, eps = 1e-6 m
+SPRING = SpringLaw()   # docs/model.md#input-springs defaults k0 = 1e9 N/m, eps = 1e-6 m
 P1, P2, P3 = 0, 1, 2
 
 
@@ -57,7 +58,7 @@ def independent_resultants(geom, sol):
 def test_paper_region_layout(pair, r_top, r_half, kind, k_t):
     g = SliderGeometry.paper_region(pair, kind)
     assert g.k_t == k_t
-    assert g.n_springs == 160                                     # SCENARIOS A6
+    assert g.n_springs == 160                                     # docs/model.md#input-springs
     assert g.half_width == pytest.approx(0.15)
     np.testing.assert_allclose(g.arcs[:, 2], [r_top, r_top, r_half], rtol=0, atol=1e-15)
     assert [int(g.mask(arc=j).sum()) for j in (P1, P2, P3)] == [40, 40, 80]
@@ -263,8 +264,8 @@ def test_k0_times_10_equals_eps_times_10():
 
 
 @pytest.mark.parametrize("eps,F,M", [
-    (1e-6, 2.5e5, 1e5),       # A6 defaults, realistic load: the bound holds but is loose (~75 %)
-    (1e-6, 2.5e7, 1e7),       # A6 defaults, 100x load: compressions >> 10 eps
+    (1e-6, 2.5e5, 1e5),       # default eps, realistic load: the bound holds but is loose (~75 %)
+    (1e-6, 2.5e7, 1e7),       # default eps, 100x load: compressions >> 10 eps
     (1e-8, 2.5e5, 1e5),       # realistic load with eps = 1e-8 m
     (1e-8, 1e6, -3e5),
 ])

@@ -215,7 +215,8 @@ def test_separate_planes_splits_a_mixed_near_degenerate_pair():
 
 
 def _cubic_schedule_return(booms, task):
-    """Unscaled return of the paper's cubic schedule (SCENARIOS A4) fed as mean accelerations."""
+    """Unscaled return of the paper's cubic schedule (docs/model.md#input-drive) fed as mean
+    accelerations."""
     from sim_core.physics.drive_profiles import CubicSmoothstepSchedule
     env = TelescopicBoomEnv(booms=booms, task=task)
     env.reset(seed=0)

@@ -124,11 +124,11 @@ def test_non_finite_action_raises(bad):
 
 
 def test_cubic_schedule_as_actions_reproduces_scene():
-    """The paper's schedule (SCENARIOS A4) fed as actions: the action of step k is the mean
-    acceleration (v(t_k+1) - v(t_k)) / dt, so the stroke rate is exact at the step ends and the
-    stroke error is at most N_moving * dt^3 * max|jerk| / 12 (bound of the chord rule).  The
-    tip response equals sim_core.simulate on the rl scene, which uses the same kinematics and
-    the same ROM (agreement to round-off)."""
+    """The paper's schedule (docs/model.md#input-drive) fed as actions: the action of step k is
+    the mean acceleration (v(t_k+1) - v(t_k)) / dt, so the stroke rate is exact at the step ends
+    and the stroke error is at most N_moving * dt^3 * max|jerk| / 12 (bound of the chord rule).
+    The tip response equals sim_core.simulate on the rl scene, which uses the same kinematics
+    and the same ROM (agreement to round-off)."""
     import sim_core
     from sim_core.physics.drive_profiles import CubicSmoothstepSchedule
     sc = sim_core.load_scene("telescopic_extraction_rl")

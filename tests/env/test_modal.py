@@ -25,8 +25,8 @@ def test_tables_cover_the_paper_scenes_and_are_physical():
     f1 = r["omega"][0, :, :, 0]
     assert np.all(np.diff(f1, axis=1) < 0) and np.all(np.diff(f1, axis=0) < 0)
     # static tip moves 2 m per m of piston length along the boom (booms 2 and 3 both slide,
-    # the rope mechanism of SCENARIOS A3): |d r_s / dL_s| = 2 within the sag change (< 1 %)
-    # at every tabulated angle, 25 t
+    # the rope mechanism of docs/model.md#input-ropes): |d r_s / dL_s| = 2 within the sag
+    # change (< 1 %) at every tabulated angle, 25 t
     slope = np.linalg.norm(r["tip_dL"][:, 1, 1:][..., [0, 2]], axis=-1)
     assert np.allclose(slope, 2.0, rtol=1e-2)
     # the luffing plane is a plane of symmetry: no lateral (Y) stroke tangent.  The implicit-
@@ -37,7 +37,7 @@ def test_tables_cover_the_paper_scenes_and_are_physical():
 
 
 def test_filter_damping_of_the_bending_mode_matches_h_omega_over_4():
-    """SCENARIOS B 'Filter': the stress filter adds the damping (h/2) K_mat (K_mat: the
+    """docs/model.md#input-filter: the stress filter adds the damping (h/2) K_mat (K_mat: the
     material stiffness, int B^T D B ds) and the mass (h^2/6) K_mat; the ropes are undamped.  With
     phi mass-normalised on that mass, zeta = (h/4) phi^T K_mat phi / omega exactly, so
     zeta / (h omega / 4) = 1 + s, s = -phi^T (K - K_mat) phi / omega^2: the share of the
@@ -95,7 +95,7 @@ def test_scene_route_runs_the_rom():
     for k in ("tip_position", "tip_velocity", "piston_stroke"):
         assert np.all(np.isfinite(res[k]))
     assert res["tip_position"].shape == (len(res.t), 3)
-    assert abs(res["piston_stroke"][-1] - 6.0) < 1e-9             # 2 -> 8 m (A4)
+    assert abs(res["piston_stroke"][-1] - 6.0) < 1e-9             # 2 -> 8 m (docs/model.md#input-drive)
     assert res.stats["real_time_factor"] > 20
 
 

@@ -45,7 +45,8 @@ def _circle_intersection(F, rF, G, rG, side):
 
 
 def closed_form_tip(s1, s2, phi, L=12.0):
-    """Boom-2 tip of the rigid linkage (SCENARIOS B geometry) for pin distances s1, s2 (m) and
+    """Boom-2 tip of the rigid linkage (geometry of docs/model.md#input-folding-geometry) for pin
+    distances s1, s2 (m) and
     slew angle phi (rad) -- written independently of sim_core.systems.folding.build.linkage_points."""
     A, base = np.array([0.0, 2.0]), np.array([0.5, 0.6])
     rho, delta = np.hypot(3.0, 0.35), np.arctan2(-0.35, 3.0)

@@ -1,14 +1,15 @@
-"""Stress filter (second seed Eq. 53; SCENARIOS B "Filter"): increasing h removes the
+"""Stress filter (second seed Eq. 53; docs/model.md#input-filter): increasing h removes the
 high-frequency content of the boom-2 tip velocity while the low-frequency response changes
 little.
 
-Theory (SCENARIOS B): the filter turns a mode omega into omega/sqrt(1 + h^2 omega^2/6) with
-damping ratio zeta ~ h omega / 4.  Cutoff f_c = 20 Hz (omega_c = 126 1/s): above it zeta >= 0.16
-for h = 0.005 s but only >= 0.063 for h = 0.002 s; over the ~0.3 s of free vibration after the
-drive stops a single mode's energy ratio is <= exp(-2 (0.16 - 0.063) 126 0.3) ~ 1e-3, so the
-high-band energy must drop clearly (assert: by more than 2x; measured 0.112 -> 0.026, ratio
-0.24).  Below f_low = 5 Hz, zeta <= 0.04 (h = 0.005) and the frequency shift <= 0.2 %: the low
-band (dominated by the driven motion) must agree to 10 % (RMS of the difference / RMS).
+Theory (docs/model.md#input-filter): the filter turns a mode omega into
+omega/sqrt(1 + h^2 omega^2/6) with damping ratio zeta ~ h omega / 4.  Cutoff f_c = 20 Hz
+(omega_c = 126 1/s): above it zeta >= 0.16 for h = 0.005 s but only >= 0.063 for h = 0.002 s;
+over the ~0.3 s of free vibration after the drive stops a single mode's energy ratio is
+<= exp(-2 (0.16 - 0.063) 126 0.3) ~ 1e-3, so the high-band energy must drop clearly (assert: by
+more than 2x; measured 0.112 -> 0.026, ratio 0.24).  Below f_low = 5 Hz, zeta <= 0.04
+(h = 0.005) and the frequency shift <= 0.2 %: the low band (dominated by the driven motion) must
+agree to 10 % (RMS of the difference / RMS).
 
 Coarse, luffing only, gravity off (the drive excites the booms: Eq. 52 acceleration jumps at
 t_b and t_c), 2 sub-elements per boom, compressed profile.  Runtime 4 + 6 min on the shared

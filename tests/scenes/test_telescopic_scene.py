@@ -113,9 +113,15 @@ def test_unknown_key_suggests():
     assert "effects.fricton: unknown key" in msg and "did you mean 'friction'" in msg
 
 
-def test_contact_distribution_needs_the_paper_three_booms():
-    msg = _err({"booms.count": 2, "effects.friction": False, "effects.contact_distribution": True})
-    assert "effects.contact_distribution = true with booms.count = 2" in msg
+def test_contact_distribution_of_two_shorthand_booms_is_the_papers_pair_1_2():
+    """The shorthand's two booms are the paper's booms 1 and 2 (params.crane_sections): their
+    slider springs are the paper's regions of pair 1-2."""
+    from sim_core.physics.contact import SliderGeometry
+    from sim_core.systems.telescopic.sliders import slider_geometries
+    sc = load_scene(SCENE, overrides={"booms.count": 2, "effects.contact_distribution": True})
+    (inner, outer), = slider_geometries(params_from_scene(sc))
+    ref = SliderGeometry.paper_region(1, "inner", radial_gap=0.005)
+    assert inner.arcs.tolist() == ref.arcs.tolist() and (inner.k_t, outer.k_t) == (-1, 1)
 
 
 def test_rigid_limit_rejects_friction():

@@ -3,11 +3,11 @@ have no static equilibrium under their own weight with the paper's luffing geome
 
 Why (found 2026-11-24, formerly a strict xfail "Newton does not converge"): at 0 deg the luffing
 cylinder D2-D3 runs almost along the boom and its lever about the pivot D1 is 0.23 m (0.714 m at
-the paper's 60 deg; SCENARIOS A2 already flags the lever as small).  The weight's moment
-about D1 needs a cylinder force of ~M / 0.23 m, which compresses and bends boom 1 between D1 and
-D3; the boom rotates down, and the rotation shortens the lever further.  Below some stiffness
-this softening wins: the equilibrium path in the load factor (weight x lambda) turns back at a
-limit point.  The statics trace the path by pseudo-arclength continuation
+the paper's 60 deg; docs/model.md#input-luffing already flags the lever as small).  The weight's
+moment about D1 needs a cylinder force of ~M / 0.23 m, which compresses and bends boom 1 between
+D1 and D3; the boom rotates down, and the rotation shortens the lever further.  Below some
+stiffness this softening wins: the equilibrium path in the load factor (weight x lambda) turns
+back at a limit point.  The statics trace the path by pseudo-arclength continuation
 (sim_core.model.statics.load_continuation) and raise the typed NoStaticEquilibrium there.
 
 Facts checked: the limit point lies below the full weight (soft booms), the error names the

@@ -22,7 +22,8 @@ LOOSE = {"solver.rtol": 1e-5, "solver.atol": 1e-6}
 
 
 def test_slope_band_is_where_the_friction_coefficient_varies():
-    """in_slope_band(v) is True exactly where d mu / dv != 0 (SCENARIOS A6's law)."""
+    """in_slope_band(v) is True exactly where d mu / dv != 0 (the law of
+    docs/model.md#input-friction)."""
     law = FrictionLaw(0.15, 0.1, 0.01)
     for v in np.concatenate([np.linspace(-0.05, 0.05, 201), [0.0199, 0.0201, -0.0201]]):
         assert law.in_slope_band(v) == (law.dmu_dv(v) != 0.0), v

@@ -36,7 +36,8 @@ def test_rigid_inextensible_tip_follows_eqs_74_76():
 
 
 def test_rigid_static_forces_match_moment_balance():
-    """At rest the rigid model's forces are SCENARIOS C7 (independent closed-form code path)."""
+    """At rest the rigid model's forces are those of docs/model.md#check-static-luffing
+    (independent closed-form code path)."""
     for elastic in (False, True):
         rig, p = _rigid(rope_elasticity=elastic)
         res = rig.simulate(0.5, 3)                      # schedule starts at rest: a(0) = 0
@@ -107,9 +108,9 @@ def test_torsion_off_changes_nothing_in_the_plane(equilibria):
 
 def test_inextensible_rope_carries_the_closed_form_tension(equilibria):
     """rope_elasticity = false: the rope multiplier is the rope tension T = (m3 + m_p) g sin th
-    (SCENARIOS C7; the flexible booms' small rotations change it by < 0.5 %, the tolerance of the
-    existing C7 test), and the elastic rope gives the same equilibrium up to its stretch
-    (T L0 / EA ~ 2 mm along the axis)."""
+    (docs/model.md#check-static-luffing; the flexible booms' small rotations change it by
+    < 0.5 %, the tolerance of the existing static-luffing test), and the elastic rope gives the
+    same equilibrium up to its stretch (T L0 / EA ~ 2 mm along the axis)."""
     ts, z, lam = equilibria["rigid_rope"]
     T = -lam[ts.rows["rope"]][0]
     ref = static_luffing_forces(THETA, 2.0, PAPER["payload"], z_c=(0.0, 0.0, 0.0))

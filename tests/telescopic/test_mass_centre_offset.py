@@ -1,5 +1,6 @@
-"""Mass-centre offset z_c of paper Table 2 (SCENARIOS A1) in the telescopic system: the static
-luffing-cylinder force follows the moment balance of SCENARIOS C7 *with* the offsets."""
+"""Mass-centre offset z_c of paper Table 2 (docs/model.md#input-sections) in the telescopic
+system: the static luffing-cylinder force follows the moment balance of
+docs/model.md#check-static-luffing *with* the offsets."""
 
 import math
 
@@ -23,7 +24,8 @@ def test_rigid_model_luffing_force_with_offsets_is_c7():
 
 def test_flexible_static_forces_with_offsets_match_c7():
     """Nearly rigid booms (E = 2.1e12 Pa, 1 t): the luffing force with the Table 2 offsets is
-    C7 with z_c; the offsets move it by 0.7 % (C7 with z_c = 0 vs with z_c), and the model must
+    the moment balance of docs/model.md#check-static-luffing with z_c; the offsets move it by
+    0.7 % (that balance with z_c = 0 vs with z_c), and the model must
     reproduce that shift to within 20 % of it (the remaining difference, ~2e-4, is the elastic
     sag of the E = 2.1e12 booms, as in the z_c = 0 test).  The telescopic force is axial and
     does not change with the offset (0.5 % as in the z_c = 0 test)."""

@@ -39,17 +39,18 @@ def test_initial_configuration_satisfies_constraints_and_matches_paper_geometry(
     m = ts.model
     z, zd = m.reduced_state(0.0, ts.Q0, np.zeros_like(ts.Q0))
     assert np.max(np.abs(m.constraint_violation(0.0, z, zd))) < 1e-12
-    # top centre of boom 3 at t = 0 (SCENARIOS A9): (7.404, 13.024) m
+    # top centre of boom 3 at t = 0 (docs/model.md#input-rigid-limit): (7.404, 13.024) m
     r = ts.tip(ts.Q0)[0]
     assert r[0] == pytest.approx(7.40351, abs=1e-4)
     assert r[2] == pytest.approx(13.02428, abs=1e-4)
 
 
 def test_static_forces_match_rigid_balance(rigid_equilibrium):
-    """SCENARIOS C7: luffing-cylinder force from moments about D1, telescopic force
-    m2 g sin(th) + 2 T and extraction-rope tension T = (m3 + m_p) g sin(th); 0.5 % (rigid).
-    The mass centre lies on the reference line by default (mass_centre_offset = false), so the
-    reference is evaluated with z_c = 0 (with the offsets: test_mass_centre_offset.py)."""
+    """docs/model.md#check-static-luffing: luffing-cylinder force from moments about D1,
+    telescopic force m2 g sin(th) + 2 T and extraction-rope tension T = (m3 + m_p) g sin(th);
+    0.5 % (rigid).  The mass centre lies on the reference line by default
+    (mass_centre_offset = false), so the reference is evaluated with z_c = 0 (with the offsets:
+    test_mass_centre_offset.py)."""
     ts, z, lam = rigid_equilibrium
     ref = static_luffing_forces(np.radians(60.0), 2.0, 1000.0, z_c=(0.0, 0.0, 0.0))
     assert abs(lam[ts.rows["luffing_cylinder"]][0]) == pytest.approx(ref.luffing_force, rel=5e-3)
@@ -63,7 +64,8 @@ def test_static_forces_match_rigid_balance(rigid_equilibrium):
 
 
 def test_rigid_limit_extraction_follows_paper_kinematics(rigid_equilibrium):
-    """SCENARIOS A9/C6: in the nearly rigid limit the tip moves by 2 s0(t) (cos th, sin th).
+    """docs/model.md#check-rigid-limit: in the nearly rigid limit the tip moves by
+    2 s0(t) (cos th, sin th).
     Short run (0.5 s, tip displacement 7 mm); tolerance 1e-4 m on the displacement."""
     ts, z, _ = rigid_equilibrium
     m = ts.model
@@ -82,14 +84,16 @@ def test_rigid_limit_extraction_follows_paper_kinematics(rigid_equilibrium):
 
 
 def test_retraction_start_static_forces():
-    """Retraction scene start (L_s = 8 m, booms 1 and 3 no longer overlap): C7 forces, 0.5 %."""
+    """Retraction scene start (L_s = 8 m, booms 1 and 3 no longer overlap): forces of
+    docs/model.md#check-static-luffing, 0.5 %."""
     p = TelescopicParams(n_nodes=3, E=2.1e12, payload=1000.0, stroke0=8.0, direction=-1)
     ts = build_telescopic(p)
     z, lam = initial_equilibrium(ts)
     ref = static_luffing_forces(np.radians(60.0), 8.0, 1000.0, z_c=(0.0, 0.0, 0.0))
     assert abs(lam[ts.rows["luffing_cylinder"]][0]) == pytest.approx(ref.luffing_force, rel=5e-3)
     assert abs(lam[ts.rows["telescopic_cylinder"]][0]) == pytest.approx(ref.telescopic_force, rel=5e-3)
-    # tip near the rigid start point of SCENARIOS A9 (13.404, 23.417) m: E = 2.1e12 sag < 1 cm
+    # tip near the rigid start point of docs/model.md#input-rigid-limit (13.404, 23.417) m:
+    # E = 2.1e12 sag < 1 cm
     Q, _ = ts.model.full_state(0.0, z, np.zeros_like(z))
     r = ts.tip(Q)[0]
     assert r[0] == pytest.approx(13.4035, abs=1e-2)

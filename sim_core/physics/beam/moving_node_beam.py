@@ -55,9 +55,9 @@ class BeamSection:
     per length about e_s, e_t, e_b, kg m (= rho I).
     Constitutive diagonal D = diag(EA, GJ, EI_t, EI_b) (Eq. 36).
     y_c, z_c : mass-centre offset from the reference line along e_t and e_b, m (paper Table 2:
-    z_c = 0.045 / 0.044 / 0.043 m).  A rigid offset in inertia and gravity (SCENARIOS A1 PD):
-    the stiffness stays on the reference line; the rotary inertia J is taken about the mass
-    centre.  0 (default): mass on the reference line.
+    z_c = 0.045 / 0.044 / 0.043 m).  A rigid offset in inertia and gravity (PD,
+    docs/model.md#input-sections): the stiffness stays on the reference line; the rotary
+    inertia J is taken about the mass centre.  0 (default): mass on the reference line.
     """
 
     EA: float

@@ -4,7 +4,7 @@ For every contact region (pair k, k+1; region I at boom k's inner contact sectio
 region II at boom k+1's outer contact section s_3,k+1) the constraint reaction of Constraint I or
 II (force and moment, section frame) is distributed on the sliders' radial springs by the
 micro-motion solver (Eqs. 59-71, :mod:`sim_core.physics.contact.sliding_block_contact`); the friction
-force mu(s_dot) * sum(f_ij) (Eq. 65, regularised law of SCENARIOS A6) acts along e_s.  Its
+force mu(s_dot) * sum(f_ij) (Eq. 65, regularised law of docs/model.md#input-friction) acts along e_s.  Its
 virtual power under a relative slide is  -mu(s_dot) N delta s_dot  (Section 7: the contact
 multiplier eta), so it enters the equations as the generalized force -mu(s_dot) N on the contact
 coordinate s_2,k or s_3,k+1.  Because N depends on the multipliers, the model solves for the
@@ -114,14 +114,17 @@ class ContactFriction:
     ``"springs"`` (needs the distribution) takes the friction's normal load from their sum,
     ``"resultant"`` from the transverse contact resultant N = |(f_t, f_b)| (a lower bound of the
     spring sum: the force couples that carry the contact moment are not in it), which needs no
-    slider geometry, so any number of booms works."""
+    slider geometry.  ``geometries``: the (inner, outer) SliderGeometry of every overlap, outermost
+    first (sim_core.systems.telescopic.sliders); None: the paper's three-boom regions
+    (SliderGeometry.paper_region)."""
 
     name = "friction"
 
     def __init__(self, ts, mu_static: float, mu_dynamic: float, v_eps: float,
                  k0: float = 1e9, eps: float = 1e-6, distribution: bool = True,
                  slider_half_width: float = 0.15, springs_per_quarter: int = 20,
-                 radial_gap: float | None = None, friction_load: str | None = None):
+                 radial_gap: float | None = None, friction_load: str | None = None,
+                 geometries=None):
         if friction_load is None:
             friction_load = "springs" if distribution else "resultant"
         if friction_load not in ("springs", "resultant"):
@@ -142,9 +145,14 @@ class ContactFriction:
         for k in range(ts.params.n_booms - 1):
             inner = material_point(m, k, s_index=ts.s2_index[k])
             outer = material_point(m, k + 1, s_index=ts.s3_index[k + 1])
-            geo = tuple(SliderGeometry.paper_region(k + 1, kind, springs_per_quarter,
-                                                    slider_half_width, radial_gap)
-                        for kind in ("inner", "outer")) if distribution else (None, None)
+            if not distribution:
+                geo = (None, None)
+            elif geometries is not None:            # (inner, outer) SliderGeometry of pair k
+                geo = tuple(geometries[k])
+            else:
+                geo = tuple(SliderGeometry.paper_region(k + 1, kind, springs_per_quarter,
+                                                        slider_half_width, radial_gap)
+                            for kind in ("inner", "outer"))
             self.regions.append((f"I_{k + 1}{k + 2}", inner, ts.s2_index[k], geo[0]))
             self.regions.append((f"II_{k + 1}{k + 2}", outer, ts.s3_index[k + 1], geo[1]))
         self._x0 = {}

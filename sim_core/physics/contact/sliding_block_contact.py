@@ -2,9 +2,12 @@
 
 Source: Zhao, Qi, Wang (2024), "Dynamic Contact Analysis of Flexible Telescopic Boom Systems
 with Moving Boundary", Section 8.2 (discrete model: compression-only radial springs on the
-rounding arcs at the two slider ends) and Section 8.3 (Eqs. 59-72); proposed defaults of
-/work/shared/design/SCENARIOS.md parts A1 (section geometry, Table 1) and A6 (spring counts,
-azimuths, contact radius, k_t signs, k0, eps, friction law).
+rounding arcs at the two slider ends) and Section 8.3 (Eqs. 59-72); the inputs the paper leaves
+open are those of docs/model.md#input-sections (section geometry, Table 1) and
+docs/model.md#input-springs (spring counts, azimuths, contact radius, k_t signs, k0, eps,
+friction law).  Sections other than the paper's bear on straight faces as well as arcs
+(:class:`SliderGeometry` ``faces``): a spring on a face has the face's outward normal, and
+Eq. 61's compression map holds for any position and normal in the section plane.
 
 Frame and components
 --------------------
@@ -26,7 +29,7 @@ Smoothed compression-only spring (Eqs. 62-63): f = k(delta) delta.
 
 Sign conventions (the paper's signs were lost in extraction; resolved here)
 --------------------------------------------------------------------------
-* k_t (SCENARIOS A6): -1 for an inner region (contact section = inner contact section of the
+* k_t (docs/model.md#input-springs): -1 for an inner region (contact section = inner contact section of the
   outer boom k, slider on the outer face of boom k+1 inside it), +1 for an outer region
   (contact section = outer contact section of the inner boom k+1, slider on the inner face of
   boom k outside it).  Then delta > 0 exactly when the wall moves towards the slider.
@@ -37,7 +40,7 @@ Sign conventions (the paper's signs were lost in extraction; resolved here)
   section at the contact point's arc-coordinate rate s_dot and drags the wall with it (the
   paper's text: inner contact point during extraction, s_dot > 0, friction along +e_s; outer
   contact point, s_dot < 0, along -e_s).  Its dissipation is non-positive.  Here mu_value is the
-  signed regularised mu(s_dot) of SCENARIOS A6 (FrictionLaw.mu), replacing mu sign(s_dot).
+  signed regularised mu(s_dot) of docs/model.md#input-friction (FrictionLaw.mu), replacing mu sign(s_dot).
 * fbar_c, mbar_c (Eq. 66) are the resultants about the section centroid of the forces the section
   exerts ON THE SLIDER: f_ij (k_t n_ij - mu e_s).  With f_c, m_c the constraint reaction acting on
   the contact section (paper Section 7: f_2,k on boom k; the inner boom gets -f_2,k) the
@@ -85,7 +88,7 @@ __all__ = [
     "solve_micro_motion",
 ]
 
-# Table 1 (paper Section 9; SCENARIOS A1): outer radii (top arcs P1/P2, half circle P3), m.
+# Table 1 (paper Section 9; docs/model.md#input-sections): outer radii (top arcs P1/P2, half circle P3), m.
 _TABLE1_OUTER_RADII = {1: (0.090, 0.390), 2: (0.070, 0.370), 3: (0.050, 0.350)}
 _WALL = 0.015            # wall thickness, m (Section 9)
 _TOP_CENTRE = 0.300      # |y|, z of the P1/P2 centres, m (Table 1)
@@ -112,7 +115,7 @@ class ContactSolveError(SimulationError):
 
 @dataclass(frozen=True)
 class SpringLaw:
-    """Smoothed compression-only radial spring (paper Section 8.3, Eqs. 62-63; SCENARIOS A6).
+    """Smoothed compression-only radial spring (paper Section 8.3, Eqs. 62-63; docs/model.md#input-springs).
 
     k(delta) = 0 (delta < 0); k0 (3 x^2 - 2 x^3), x = delta/eps (0 <= delta < eps);
     k0 (delta >= eps); force f = k(delta) delta.  k is C1 (k = k' = 0 at 0, k = k0, k' = 0 at
@@ -163,7 +166,7 @@ class SpringLaw:
 class FrictionLaw:
     """Regularised Coulomb friction coefficient mu(v), v = contact point's arc-coordinate rate.
 
-    SCENARIOS A6 (PD for the paper's mu sign(s_dot), Eq. 65):
+    docs/model.md#input-friction (PD for the paper's mu sign(s_dot), Eq. 65):
     mu = mu_s v / v_eps (|v| <= v_eps); sign(v) [mu_s + (mu_d - mu_s)(3 tau^2 - 2 tau^3)],
     tau = |v|/v_eps - 1 (v_eps < |v| <= 2 v_eps); mu_d sign(v) (|v| > 2 v_eps).
     Continuous and odd in v (C0 at |v| = v_eps, C1 at 2 v_eps).
@@ -229,19 +232,26 @@ class SliderGeometry:
     half_width : w, springs at k_s w e_s, k_s = +1 (front) and -1 (back).
     arcs : (n_arcs, 6) rows (y_j, z_j, radius, theta_start, theta_end, n_springs); azimuth from
         e_t towards e_b; spring azimuths th_i = theta_start + (i - 1/2) dth, i = 1..n
-        (SCENARIOS A6).
-    k_t : compression indicator (Eq. 61), -1 inner region, +1 outer region (SCENARIOS A6).
+        (docs/model.md#input-springs).  May be empty where ``faces`` are given.
+    k_t : compression indicator (Eq. 61), -1 inner region, +1 outer region
+        (docs/model.md#input-springs).
+    faces : (n_faces, 5) rows (y_0, z_0, y_1, z_1, n_springs) of straight bearing faces,
+        traversed counter-clockwise about the section (outward normal (dz, -dy) / |d|); spring
+        i at the fraction (i - 1/2) / n along the face.  None: arcs only (the paper's sections).
 
-    Per-spring arrays (length N = 2 sum n_springs), ordered arc by arc, within an arc front end
-    (k_s = +1) then back end (k_s = -1), within an end by increasing azimuth:
-    arc_index, k_s, theta, positions (N, 3) = rbar_ij (Eq. 59), normals (N, 3) = n_ij,
-    A (N, 5) compression map delta = A x (Eq. 61), Bf (N, 5) friction moment map (see module doc).
+    Per-spring arrays (length N = 2 sum n_springs), ordered patch by patch (the arcs, then the
+    faces), within a patch front end (k_s = +1) then back end (k_s = -1), within an end by
+    increasing azimuth or position along the face: arc_index (the patch index: arcs 0..n_arcs-1,
+    faces after them), k_s, theta (azimuth of the spring's normal), positions (N, 3) = rbar_ij
+    (Eq. 59), normals (N, 3) = n_ij, A (N, 5) compression map delta = A x (Eq. 61), Bf (N, 5)
+    friction moment map (see module doc).
     """
 
     half_width: float
     arcs: np.ndarray
     k_t: int
     name: str = ""
+    faces: np.ndarray | None = None
     arc_index: np.ndarray = field(init=False, repr=False)
     k_s: np.ndarray = field(init=False, repr=False)
     theta: np.ndarray = field(init=False, repr=False)
@@ -261,43 +271,71 @@ class SliderGeometry:
             raise ValueError(f"SliderGeometry.half_width = {self.half_width!r}: must be > 0")
         if self.k_t not in (1, -1):
             raise ValueError(f"SliderGeometry.k_t = {self.k_t!r}: must be +1 or -1")
-        arcs = np.array(self.arcs, dtype=float)
-        if arcs.ndim != 2 or arcs.shape[1] != 6 or arcs.shape[0] == 0:
+        arcs = np.array(self.arcs, dtype=float).reshape(-1, 6) if np.size(self.arcs) else \
+            np.zeros((0, 6))
+        faces = (np.zeros((0, 5)) if self.faces is None or np.size(self.faces) == 0
+                 else np.array(self.faces, dtype=float))
+        if arcs.ndim != 2 or arcs.shape[1] != 6:
             raise ValueError(f"SliderGeometry.arcs: shape {arcs.shape}, expected (n_arcs, 6)")
-        if not np.all(np.isfinite(arcs)):
-            raise ValueError("SliderGeometry.arcs: non-finite entry")
-        n = arcs[:, 5]
+        if faces.ndim != 2 or faces.shape[1] != 5:
+            raise ValueError(f"SliderGeometry.faces: shape {faces.shape}, expected (n_faces, 5)")
+        if arcs.shape[0] + faces.shape[0] == 0:
+            raise ValueError("SliderGeometry: no arcs and no faces (a slider needs a bearing "
+                             "patch)")
+        if not (np.all(np.isfinite(arcs)) and np.all(np.isfinite(faces))):
+            raise ValueError("SliderGeometry.arcs/faces: non-finite entry")
+        n = np.concatenate([arcs[:, 5], faces[:, 4]])
         if np.any(n < 1) or np.any(n != np.round(n)):
-            raise ValueError(f"SliderGeometry.arcs: n_springs {n} must be positive integers")
+            raise ValueError(f"SliderGeometry: n_springs {n} must be positive integers")
         if np.any(arcs[:, 2] <= 0.0) or np.any(arcs[:, 4] <= arcs[:, 3]):
             raise ValueError("SliderGeometry.arcs: need radius > 0 and theta_end > theta_start")
+        if np.any(np.hypot(faces[:, 2] - faces[:, 0], faces[:, 3] - faces[:, 1]) <= 0.0):
+            raise ValueError("SliderGeometry.faces: a face of zero length")
 
-        idx, ks, th, yc, zc, rr = [], [], [], [], [], []
+        idx, ks, th, Ys, Zs, nt, nb, arm = [], [], [], [], [], [], [], []
         for j, (y, z, r, t0, t1, nj) in enumerate(arcs):
             nj = int(nj)
-            tj = t0 + (np.arange(nj) + 0.5) * (t1 - t0) / nj        # SCENARIOS A6 azimuths
+            tj = t0 + (np.arange(nj) + 0.5) * (t1 - t0) / nj    # docs/model.md#input-springs
+            c, s_ = np.cos(tj), np.sin(tj)
             for k in (1.0, -1.0):
                 idx.append(np.full(nj, j))
                 ks.append(np.full(nj, k))
                 th.append(tj)
-                yc.append(np.full(nj, y))
-                zc.append(np.full(nj, z))
-                rr.append(np.full(nj, r))
+                Ys.append(y + r * c)
+                Zs.append(z + r * s_)
+                nt.append(c)
+                nb.append(s_)
+                arm.append(y * s_ - z * c)             # (rbar x n)_s on an arc
+        for f, (y0, z0, y1, z1, nj) in enumerate(faces):
+            nj = int(nj)
+            u = (np.arange(nj) + 0.5) / nj
+            ln = math.hypot(y1 - y0, z1 - z0)
+            c, s_ = (z1 - z0) / ln, -(y1 - y0) / ln             # outward normal (dz, -dy)/|d|
+            for k in (1.0, -1.0):
+                idx.append(np.full(nj, arcs.shape[0] + f))
+                ks.append(np.full(nj, k))
+                th.append(np.full(nj, math.atan2(s_, c)))
+                Ys.append(y0 + u * (y1 - y0))
+                Zs.append(z0 + u * (z1 - z0))
+                nt.append(np.full(nj, c))
+                nb.append(np.full(nj, s_))
+                arm.append(Ys[-1] * s_ - Zs[-1] * c)  # (rbar x n)_s on a face
         idx, ks, th = np.concatenate(idx), np.concatenate(ks), np.concatenate(th)
-        yc, zc, rr = np.concatenate(yc), np.concatenate(zc), np.concatenate(rr)
-        c, s = np.cos(th), np.sin(th)
-        Y, Z = yc + rr * c, zc + rr * s
+        Y, Z = np.concatenate(Ys), np.concatenate(Zs)
+        c, s, arm = np.concatenate(nt), np.concatenate(nb), np.concatenate(arm)
         pos = np.stack([ks * w, Y, Z], axis=1)                        # Eq. 59
         nrm = np.stack([np.zeros_like(c), c, s], axis=1)
         kt = float(self.k_t)
         # Eq. 61: delta = k_t n . (u_t e_t + u_b e_b + omega x rbar) = k_t [n_t, n_b, rbar x n] . x
-        A = kt * np.stack([c, s, yc * s - zc * c, -ks * w * s, ks * w * c], axis=1)
+        # with (rbar x n)_s = Y n_b - Z n_t (= y_j sin th - z_j cos th on an arc)
+        A = kt * np.stack([c, s, arm, -ks * w * s, ks * w * c], axis=1)
         # rbar x (-mu f e_s) = mu f (0, -Z, Y): friction moment on the slider per unit mu f (Eq. 66)
         zero = np.zeros_like(c)
         Bf = np.stack([zero, zero, zero, -Z, Y], axis=1)
         set_ = object.__setattr__
         set_(self, "half_width", w)
         set_(self, "arcs", _readonly(arcs))
+        set_(self, "faces", _readonly(faces))
         set_(self, "arc_index", _readonly(idx).astype(int))
         set_(self, "k_s", _readonly(ks))
         set_(self, "theta", _readonly(th))
@@ -328,7 +366,7 @@ class SliderGeometry:
     def paper_region(cls, pair, kind: str, springs_per_quarter: int = 20,
                      half_width: float | None = None,
                      radial_gap: float | None = None) -> "SliderGeometry":
-        """A contact region of the paper's three-boom example (Section 9, SCENARIOS A1/A6).
+        """A contact region of the paper's three-boom example (Section 9, docs/model.md#input-sections and #input-springs).
 
         pair : outer boom index k of the pair (k, k+1): 1, 2, or (1, 2), (2, 3), "1-2", "2-3".
         kind : "inner" (inner contact section of boom k, left-end slider of boom k+1, k_t = -1) or
@@ -352,7 +390,7 @@ class SliderGeometry:
         if kind not in ("inner", "outer"):
             raise ValueError(f"paper_region: kind {kind!r} must be 'inner' or 'outer'")
         (r_o, big_o), (r_i, big_i) = _TABLE1_OUTER_RADII[k], _TABLE1_OUTER_RADII[k + 1]
-        r_top = 0.5 * ((r_o - _WALL) + r_i)         # mid-gap, SCENARIOS A6
+        r_top = 0.5 * ((r_o - _WALL) + r_i)         # mid-gap, docs/model.md#input-springs
         r_half = 0.5 * ((big_o - _WALL) + big_i)
         if radial_gap is not None:                   # a block of thickness radial_gap
             r_top = (r_o - _WALL) - 0.5 * radial_gap

@@ -1,8 +1,8 @@
 """Folding long-boom manipulator (second seed: SIMULTECH 2020, "folding long-boom manipulator";
-SCENARIOS.md part B): two flexible booms, turntable, two hydraulic cylinders (barrel + rod),
-two links; luffing of boom 1, slewing by 90 deg, unfolding of boom 2.
+inputs in docs/model.md#input-folding): two flexible booms, turntable, two hydraulic cylinders
+(barrel + rod), two links; luffing of boom 1, slewing by 90 deg, unfolding of boom 2.
 
-Bodies (SCENARIOS B "Bodies", PD)
+Bodies (docs/model.md#input-folding-bodies, PD)
   * booms 1, 2: the geometrically exact beam :class:`sim_core.physics.beam.moving_node_beam.Beam` with
     fixed nodes (material ends s = 0, L held by linear rows), one spline element of 8
     sub-elements, 3 Gauss points, solid round section r = 0.15 m, m' = 544.6 kg/m,
@@ -32,7 +32,7 @@ Joints (second seed Section 2.1, Eq. 7; Baumgarte Eq. 8 with xi1 = xi2 = 10 1/s 
     rotation at these pins is left to the beam - spherical on the boom side);
   * barrel - rod: prismatic = the rod's frame reads the barrel's angle coordinate (the rod has
     coordinates (u, v) only) + lateral row.
-Cylinders are spring-dampers on the pin distance s (SCENARIOS B, PD):
+Cylinders are spring-dampers on the pin distance s (docs/model.md#input-folding-drive, PD):
     F = k (s - s_ref) + c (s_dot - v(t)),  s_ref = s_ref(0) + int v dt,
 v(t) from Eq. 52 (:class:`sim_core.physics.drive_profiles.Eq52Profile`); s_ref(0) from the static
 equilibrium at t = 0 (solved with the cylinders held at their retracted length).
@@ -114,7 +114,7 @@ def boom_reference_basis() -> np.ndarray:
 
 @dataclass
 class FoldingParams:
-    """Inputs of the folding-boom scene (SI units; defaults = SCENARIOS B PDs)."""
+    """Inputs of the folding-boom scene (SI units; defaults = docs/model.md#input-folding)."""
 
     boom_length: float = 12.0               # m
     boom_radius: float = 0.15               # m
@@ -203,7 +203,8 @@ def _rot2(v, a):
 
 def linkage_points(p: FoldingParams, theta1: float, rel: float) -> dict:
     """Plane points (u, v) of the mechanism for boom-1 angle theta1 (from horizontal) and
-    boom-2 relative angle rel (180 deg folded), booms rigid (SCENARIOS B "Missing -> PD")."""
+    boom-2 relative angle rel (180 deg folded), booms rigid
+    (docs/model.md#input-folding-geometry)."""
     A = np.asarray(p.hinge_A, float)
     d1 = np.array([np.cos(theta1), np.sin(theta1)])
     n1 = _rot2(d1, np.pi / 2)

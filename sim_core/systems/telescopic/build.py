@@ -13,16 +13,21 @@ the end nodes are material points (s_1,k = 0, s_4,k = L_k, Eq. 50).  The inner c
 boom k < N is not a node: its arc-length coordinate s_2,k is an extra generalized coordinate
 (Section 5) and the point is interpolated with Eq. 6.
 
-Constraint I (Eq. 47): centroid and Cardan angles of boom k+1's left end = those of boom k at
-s_2,k.  Constraint II (Eq. 48): boom k's right end = boom k+1's outer-contact node s_3,k+1.
-Their multipliers are the contact force/moment resultants; the generalized forces they exert
-on s_2,k and s_3,k+1 are the contact multipliers eta of Section 7 (zero without friction).
+Constraint I (Eq. 47): centroid and Cardan angles of boom k+1's section at its inner slider
+(the left end, or d_in from it: ``[[overlap]] inner_slider_distance``) = those of boom k at
+s_2,k.  Constraint II (Eq. 48): boom k's section at its outer slider (the right end, or d_out
+inside it) = boom k+1's outer-contact node s_3,k+1.  Their multipliers are the contact
+force/moment resultants; the generalized forces they exert on s_2,k and s_3,k+1 are the
+contact multipliers eta of Section 7 (zero without friction).  Each boom has its own length
+L_k and section (params.BoomSpec, docs/model.md#own-crane).
 
-Mounting and drives (SCENARIOS A2-A4, proposed defaults): revolute pivot D1 about Y (rigid
-offset from boom 1's left section), luffing cylinder = massless rigid rod D2-D3 of constant
-length (its multiplier is the cylinder force), telescopic cylinder = massless actuator imposing
-the distance L_s(t) between the left-section centres of booms 1 and 2, elastic tension-only
-extraction and retraction ropes over point pulleys, payload point mass at boom N's tip.
+Mounting and drives (docs/model.md#input-luffing and #input-ropes, proposed defaults): revolute
+pivot D1 about Y (a rigid offset from boom 1's left section), luffing cylinder = massless rigid
+rod D2-D3 of constant length (its multiplier is the cylinder force; the mounting points of the
+scene's [luffing] table, docs/model.md#own-crane-luffing), telescopic cylinder = massless
+actuator imposing the distance L_s(t) between the left-section centres of booms 1 and 2,
+elastic tension-only extraction and retraction ropes over point pulleys, payload point mass at
+boom N's tip.
 """
 
 from __future__ import annotations
@@ -49,6 +54,7 @@ from sim_core.physics.effects import Effect, Elasticity, Gravity, Inertia, Stres
 from sim_core.physics.point_effects import PointMass, RopeDrive, SliderSeat
 from sim_core.systems.telescopic.luffing import luffing_geometry
 from sim_core.systems.telescopic.params import TelescopicParams, boom_section
+from sim_core.systems.telescopic.sliders import slider_geometries
 
 
 @dataclass
@@ -111,13 +117,13 @@ def rope_static_tension(p: TelescopicParams, j: int) -> float:
     F.  Boom i+1 of a cylinder stage: F = W_(i+1) + 2 T_(i+2); boom i = j of a rope unit:
     T_j = W_j + F - T_(j+2) = W_j + W_(j+1) + T_(j+2), which sums from the tip to the formula
     (docs/model.md, "N-boom drives")."""
-    masses = [p.boom_length * boom_section(i, p).rhoA for i in range(p.n_booms)]
+    masses = [p.lengths[i] * boom_section(i, p).rhoA for i in range(p.n_booms)]
     return (sum(masses[j:]) + p.payload) * p.gravity * math.sin(math.radians(p.luffing_angle_deg))
 
 
 def stage_schedules(p: TelescopicParams) -> list[CubicSmoothstepSchedule]:
     """The length L_s,k(t) of every stage k (distance of the left sections of booms k and k+1,
-    0-based), m.  ``synchronized``: every stage on the drive's cubic schedule (A4).
+    0-based), m.  ``synchronized``: every stage on the drive's cubic schedule (docs/model.md#input-drive).
     ``sequential``: one stage at a time on that schedule, shifted by the duration t_ramp +
     t_hold_end of one stroke; extraction moves the innermost stage first (the tip section out
     of its neighbour, then inwards), retraction the reverse order; a stage outside its window
@@ -156,15 +162,19 @@ def _length_of(schedule):
 
 def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
     theta = np.radians(p.luffing_angle_deg)
-    geo = luffing_geometry(theta)
+    geo = luffing_geometry(theta, *p.luffing.points())
     e = np.asarray(geo.e_s, float)
     O1 = np.asarray(geo.origin, float)
-    L, N, Ls = p.boom_length, p.n_booms, p.stroke0
+    Lk, N, Ls = p.lengths, p.n_booms, p.stroke0
+    d_in = [o.inner_distance for o in p.overlaps]     # slider centres from the boom ends, m
+    d_out = [o.outer_distance for o in p.overlaps]
     G = reference_basis(e)
     beams = []
     for k in range(N):
-        split = p.L_h if k == 0 else L - Ls
-        beams.append(Beam(f"boom{k + 1}", L, boom_section(k, p), (0.0, split, L),
+        # boom 1 splits at the luffing point, boom k+1 at the outer contact point s_3,k+1 =
+        # L_k - d_out - L_s (Eq. 50; the paper's L - L_s)
+        split = p.L_h if k == 0 else (Lk[k - 1] - d_out[k - 1]) - Ls
+        beams.append(Beam(f"boom{k + 1}", Lk[k], boom_section(k, p), (0.0, split, Lk[k]),
                           n_nodes=p.n_nodes, n_gauss=p.n_gauss, reference_basis=G))
     offsets = np.cumsum([0] + [b.n_coords for b in beams])[:-1]
     g_vec = np.array([0.0, 0.0, -p.gravity])
@@ -182,13 +192,14 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
         lin.append(no_torsion(offsets, beams))
     model = Model(beams, effects, [], lin, n_extra=N - 1, baumgarte=p.baumgarte)
 
-    # initial straight configuration: boom k's left section a_k = k L_s along boom 1 (A3)
+    # initial straight configuration: boom k's left section a_k = k L_s along boom 1
+    # (docs/model.md#input-ropes)
     Q0 = np.zeros(model.n_coords)
     for k, b in enumerate(beams):
         Q0[offsets[k]:offsets[k] + b.n_coords] = b.straight_coordinates(O1 + k * Ls * e, e)
     n_beam = int(sum(b.n_coords for b in beams))
     s2_index = [n_beam + k for k in range(N - 1)]
-    Q0[s2_index] = Ls
+    Q0[s2_index] = [Ls + d for d in d_in]
     s3_index = [int(offsets[k] + beams[k].s_coord(1)) for k in range(N)]
 
     def mp(k, **kw):
@@ -211,12 +222,13 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
         return c if len(k) == 3 else _rows(c, k)
 
     # pivot D1: revolute about Y (point fixed, beta = gamma = 0 at boom 1's left section)
-    D1 = mp(0, s_fixed=0.0, offset=(-0.956, 0.0, 0.556))
+    _, _, rbar1, rbar3 = p.luffing.points()
+    D1 = mp(0, s_fixed=0.0, offset=rbar1)
     add(point_coincidence("pivot", D1, fixed=geo.d1))
     root = mp(0, s_fixed=0.0)
     add(angles("pivot_axis", root, fixed=[0.0, 0.0, 0.0], keep=(1, 2)))
-    # luffing cylinder: rigid massless rod D2-D3 held at its initial length (A2)
-    D3 = mp(0, s_fixed=p.L_h, offset=(0.0, 0.0, -0.556))
+    # luffing cylinder: rigid massless rod D2-D3 held at its initial length (docs/model.md#input-luffing)
+    D3 = mp(0, s_fixed=p.L_h, offset=(0.0, 0.0, rbar3[2]))
     Lc = float(geo.cylinder_length)
     add(distance_driver("luffing_cylinder", D3, fixed_point(geo.d2), lambda t: (Lc, 0.0, 0.0)))
     # contact constraints I and II between adjacent booms (Section 6).  The moment model decides
@@ -238,9 +250,11 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
                                      p.seat_stiffness, name=name + "_seat")
 
     for k in range(N - 1):
-        contact_region(f"I_{k + 1}{k + 2}", mp(k + 1, s_fixed=0.0), mp(k, s_index=s2_index[k]))
-        contact_region(f"II_{k + 1}{k + 2}", mp(k, s_fixed=L), mp(k + 1, s_index=s3_index[k + 1]))
-    # the drive: telescopic cylinders (prescribed distances of left sections, A3, A4) and rope
+        contact_region(f"I_{k + 1}{k + 2}", mp(k + 1, s_fixed=d_in[k]),
+                       mp(k, s_index=s2_index[k]))
+        contact_region(f"II_{k + 1}{k + 2}", mp(k, s_fixed=Lk[k] - d_out[k]),
+                       mp(k + 1, s_index=s3_index[k + 1]))
+    # the drive: telescopic cylinders (prescribed distances of left sections, docs/model.md#input-drive) and rope
     # units (module docstring, "N-boom drives")
     sched = CubicSmoothstepSchedule(v_max=p.v_max, t_ramp=p.t_ramp, t_hold_end=p.t_hold_end,
                                     sign=p.direction, s0=Ls)
@@ -258,17 +272,18 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
         rows[nm] = slice(i, i + m)
         i += m
 
-    tip = mp(N - 1, s_fixed=L)
+    tip = mp(N - 1, s_fixed=Lk[N - 1])
     pe = []
     if p.payload > 0:
         pe.append(PointMass(tip, p.payload, g_vec if p.gravity > 0 else None))
     ropes = []
     for j in rope_booms:
         # rope unit of boom j (0-based): anchored on boom j-2, over a pulley on boom j-1, fixed
-        # to boom j's left section (SCENARIOS A3 for j = 2, repeated along the boom)
-        ext = [mp(j - 2, s_fixed=0.0, offset=(0.05, 0, 0)), mp(j - 1, s_fixed=9.0),
+        # to boom j's left section (docs/model.md#input-ropes for j = 2, repeated along the boom)
+        # (the pulley 1 m inside boom j-1's right end: s = 9 m on the paper's 10 m booms)
+        ext = [mp(j - 2, s_fixed=0.0, offset=(0.05, 0, 0)), mp(j - 1, s_fixed=Lk[j - 1] - 1.0),
                mp(j, s_fixed=0.0, offset=(-0.04, 0, 0))]
-        ret = [mp(j - 2, s_fixed=L, offset=(0.68, 0, 0)), mp(j - 1, s_fixed=0.66),
+        ret = [mp(j - 2, s_fixed=Lk[j - 2], offset=(0.68, 0, 0)), mp(j - 1, s_fixed=0.66),
                mp(j, s_fixed=0.0, offset=(0.64, 0, 0))]
         en, rn, bn = rope_names(j)
         if p.rope_elasticity:
@@ -277,7 +292,7 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
             ell_e = float(rope.length(Q0)[0])
             # unstretched length from the static rope tension of the rigid, frictionless boom:
             # the rope of boom j carries booms j..N and the payload, T = (sum m_i + m_p) g
-            # sin(theta) (SCENARIOS C7 for j = 2: (m3 + m_p) g sin(theta))
+            # sin(theta) (docs/model.md#check-static-luffing for j = 2: (m3 + m_p) g sin(theta))
             T0 = rope_static_tension(p, j)
             rope.L0 = ell_e / (1.0 + T0 / EA)
             retr = RopeDrive(ret, EA, 1.0, name=rn)
@@ -296,14 +311,11 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
     ts = TelescopicSystem(model, Q0, sched, s2_index, s3_index, rows, tip, p,
                           angle_rows=angle_rows, seats=seats, drives=drives, ropes=ropes,
                           stages=stages)
-    # Section 8 contact analysis: the slider-spring distribution needs the paper's three-boom
-    # slider geometry; with friction off it is only evaluated for the outputs (it does not act
-    # on the motion), with contact_distribution off it is not built at all
+    # Section 8 contact analysis: the slider springs on every overlap's bearing patches
+    # (sim_core.systems.telescopic.sliders); with friction off it is only evaluated for the
+    # outputs (it does not act on the motion), with contact_distribution off it is not built
     if p.contact_distribution is None:
-        p.contact_distribution = N == 3
-    if p.contact_distribution and N != 3:
-        raise ValueError(f"contact_distribution with n_booms = {N}: the slider geometry is the "
-                         "paper's three-boom section (allowed: 3)")
+        p.contact_distribution = N == 3 or p.booms is not None
     if p.friction and p.friction_load == "springs" and not p.contact_distribution:
         raise ValueError("friction_load = 'springs' needs contact_distribution (the slider "
                          "springs); allowed: friction_load = 'resultant'")
@@ -313,7 +325,9 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
                                      p.spring_eps, distribution=p.contact_distribution,
                                      slider_half_width=0.5 * p.slider_width,
                                      springs_per_quarter=p.springs_per_quarter,
-                                     radial_gap=p.radial_gap, friction_load=p.friction_load)
+                                     radial_gap=p.radial_gap, friction_load=p.friction_load,
+                                     geometries=slider_geometries(p) if p.contact_distribution
+                                     else None)
     if p.friction:
         model.multiplier_forces = [ts.contact]
     return ts
@@ -338,13 +352,14 @@ def _rows(c: NonlinearConstraint, keep: list[int]) -> NonlinearConstraint:
 
 
 def initial_equilibrium(ts: TelescopicSystem, t: float = 0.0):
-    """Static equilibrium at t = 0 with the rope lengths of SCENARIOS A3: the retraction rope is
-    'just taut' *at the equilibrium*: it is slack while the equilibrium is solved, then its
-    unstretched length is set to its length there (zero tension, no change of the equilibrium).
+    """Static equilibrium at t = 0 with the rope lengths of docs/model.md#input-ropes: the
+    retraction rope is 'just taut' *at the equilibrium*: it is slack while the equilibrium is
+    solved, then its unstretched length is set to its length there (zero tension, no change of
+    the equilibrium).
     Returns (z, lambda).
 
     Two-rope statics (our reading): when the static extraction-rope tension T0 =
-    (m3 + m_p) g sin(theta) (C7) is not clearly in the rope's stiff branch (T0 <= (EA/L0) *
+    (m3 + m_p) g sin(theta) (docs/model.md#check-static-luffing) is not clearly in the rope's stiff branch (T0 <= (EA/L0) *
     slack_width, e.g. payload 0 at 0 deg), both tension-only ropes would sit at their kink with
     zero axial stiffness and boom 3's axial position is undetermined (Newton stalled at |r| ~
     0.3 N).  Then the equilibrium is solved with the extraction rope *bilateral* (a linear spring
@@ -364,7 +379,7 @@ def initial_equilibrium(ts: TelescopicSystem, t: float = 0.0):
     except NoStaticEquilibrium as exc:
         # the statics' load continuation found a limit point below the full weight: say why
         p = ts.params
-        lever = luffing_geometry(math.radians(p.luffing_angle_deg)).lever
+        lever = luffing_geometry(math.radians(p.luffing_angle_deg), *p.luffing.points()).lever
         raise NoStaticEquilibrium(exc.t, exc.load_factor_max, exc.path, reason=(
             f"no static equilibrium at luffing angle {p.luffing_angle_deg:g} deg (E = {p.E:.3g} "
             f"Pa, payload {p.payload:g} kg): the equilibrium path under the weight turns back at "
@@ -397,7 +412,7 @@ def _initial_equilibrium(ts: TelescopicSystem, t: float):
 
     soft = [(ext, retr) for ext, retr in ts.ropes if not stiff(ext, z0)]
     soft_ids = {id(ext) for ext, _ in soft}
-    if not soft:                                   # every rope in its stiff branch: as A3 says
+    if not soft:                                   # every rope in its stiff branch: as #input-ropes says
         z, lam = constrained_static_equilibrium(m, z0, t)
         for _, retr in ts.ropes:
             retr.L0 = length(retr, z)
@@ -503,8 +518,11 @@ def _telescopic_result(ts: TelescopicSystem, t, ys, stats, error, scene=None):
         if ts.contact is not None:
             sols = ts.contact.solve_regions(Q, Qd, lam)
             if ts.contact.distribution:
+                # regions of different layouts: padded with NaN to the largest spring count
+                forces = [sol.normal_force for _, _, _, sol in sols]
+                n_max = max(f.size for f in forces)
                 out.setdefault("slider_contact_forces", []).append(
-                    [sol.normal_force for _, _, _, sol in sols])
+                    [np.pad(f, (0, n_max - f.size), constant_values=np.nan) for f in forces])
             if p.friction:
                 out.setdefault("friction_coefficient", []).append([mu for _, _, mu, _ in sols])
         if "rope" in ts.rows:

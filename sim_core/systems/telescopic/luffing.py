@@ -1,8 +1,8 @@
 """Luffing geometry of the telescopic crane (Zhao-Qi-Wang 2024, Section 9, Fig. 13a; the
-mounting points and signs of SCENARIOS A2): boom 1 pivots about D1, the luffing cylinder runs
+mounting points and signs of docs/model.md#input-luffing): boom 1 pivots about D1, the luffing cylinder runs
 from D2 (on the base) to D3 (on boom 1).
 
-Frames (SCENARIOS A1/A2): global X forward, Z up, Y = Z x X.  Boom-1 left-section components are
+Frames (docs/model.md#input-luffing): global X forward, Z up, Y = Z x X.  Boom-1 left-section components are
 (axial e_s, lateral e_t, e_b); at theta = 0 they coincide with (X, Y, Z).  PD rotation
 R(theta) = [[cos, 0, -sin], [0, 1, 0], [sin, 0, cos]] maps them to global; theta > 0 lifts the tip.
 """
@@ -23,7 +23,7 @@ RBAR3_DEFAULT = (7.250, 0.0, -0.556)
 
 
 def luffing_rotation(theta: float) -> np.ndarray:
-    """PD rotation R(theta) (SCENARIOS A2): boom-1 section components -> global, theta in rad."""
+    """PD rotation R(theta) (docs/model.md#input-luffing): boom-1 section components -> global, theta in rad."""
     ct, st = math.cos(theta), math.sin(theta)
     return np.array([[ct, 0.0, -st], [0.0, 1.0, 0.0], [st, 0.0, ct]])
 
@@ -51,7 +51,7 @@ class LuffingGeometry:
 def luffing_geometry(theta: float, r1: Sequence[float] = R1_DEFAULT,
                      r2: Sequence[float] = R2_DEFAULT, rbar1: Sequence[float] = RBAR1_DEFAULT,
                      rbar3: Sequence[float] = RBAR3_DEFAULT) -> LuffingGeometry:
-    """Geometry of Zhao-Qi-Wang 2024 Sec. 9 / SCENARIOS A2: L_cyl = |r1 - r2 + R(rbar3 - rbar1)|.
+    """Geometry of Zhao-Qi-Wang 2024 Sec. 9 / docs/model.md#input-luffing: L_cyl = |r1 - r2 + R(rbar3 - rbar1)|.
 
     theta in rad; r1, r2 global (m); rbar1, rbar3 in boom-1 left-section components (m).
     At theta = 60 deg: L_cyl = 8.147 m, O = (0.4035, 0, 0.8999) m, lever = 0.714 m.

@@ -21,7 +21,7 @@ discretisation (n_nodes = 3 per spline element, frictionless resultants, stress 
    z_s(L_s) under gravity and payload is solved (``constrained_static_equilibrium``).  The ropes
    (every rope unit of the crane) keep the unstretched lengths of the reference build at
    ``stroke_ref`` (the physical ropes of the scene; their lengths are stroke invariant,
-   SCENARIOS A3);
+   docs/model.md#input-ropes);
 2. the reduced tangent stiffness K = -d(F_r + C^T lambda)/dz (``tangent_stiffness``: central
    differences, step 1e-8 max(1, max|z|), symmetrised; constraint multipliers frozen: geometric
    stiffness of the constraints included), the reduced damping
@@ -43,8 +43,8 @@ discretisation (n_nodes = 3 per spline element, frictionless resultants, stress 
    quotient of dz_s/dL_s along the grid);
 6. the static tip position r_s(L_s) (boom N, s = L) and the tip components of every mode
    phi_tip,i = J_tip P phi_i are tabulated, with the modal damping zeta_i = phi_i^T D phi_i /
-   (2 omega_i) of the full model (the filter alone gives zeta ~ h omega / 4, SCENARIOS B
-   "Filter"; the rope damping adds to it).
+   (2 omega_i) of the full model (the filter alone gives zeta ~ h omega / 4,
+   docs/model.md#input-filter; the rope damping adds to it).
 
 ROM dynamics (projection of M Q_ddot = F + C^T lambda onto the modes about the moving static
 equilibrium Q = Q_s(L_s(t)) + sum_i phi_i q_i, with a = L_s_ddot, v = L_s_dot):
@@ -80,7 +80,8 @@ from sim_core.systems.telescopic.params import TelescopicParams
 
 DATA = Path(__file__).parent / "data" / "modal_telescopic.npz"      # the paper's three booms
 N_MODES_TABLE = 4
-# Table grid (SCENARIOS A4 stroke range 2 -> 8 m plus margin for the end stops of boom_env).
+# Table grid (stroke range 2 -> 8 m of docs/model.md#input-drive plus margin for the end stops
+# of boom_env).
 L_GRID = np.linspace(1.75, 8.25, 11)       # avoids stroke_ref = 2 m (rope kink, see below)
 PAYLOADS = (20000.0, 25000.0, 30000.0)          # kg
 ANGLES = (45.0, 60.0, 75.0)                     # deg (the paper's 60 deg +- 15 deg)
@@ -304,7 +305,7 @@ def tangent_stiffness(parts, z, lam, rel_step=K_REL_STEP, central=True, symmetri
 def reference_rope_lengths(p, stroke_ref=STROKE_REF) -> dict:
     """Unstretched rope lengths (m) of the scene ``p`` (TelescopicParams): those of its static
     equilibrium at piston length ``stroke_ref``, where the retraction rope is set just taut
-    (SCENARIOS A3).  The ropes keep them at every other piston length."""
+    (docs/model.md#input-ropes).  The ropes keep them at every other piston length."""
     ref = build_telescopic(replace(p, stroke0=stroke_ref))
     initial_equilibrium(ref)
     return {k: r.L0 for k, r in _ropes(ref.model).items()}

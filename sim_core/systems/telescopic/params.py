@@ -1,4 +1,4 @@
-"""Inputs of the telescopic boom system (Zhao-Qi-Wang 2024, Section 9; SCENARIOS A1-A6) and
+"""Inputs of the telescopic boom system (Zhao-Qi-Wang 2024, Section 9; docs/model.md#inputs-and-decisions) and
 the cross-section of each boom: Table 2 for the paper's three booms, and for cranes of four to
 six sections the same U-section family continued outwards (:func:`crane_sections`).  SI units."""
 
@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from sim_core.physics.beam.moving_node_beam import BeamSection
 from sim_core.physics.sections import USection, section_properties
 
-# SCENARIOS A1 Table 2 (EI_t = EI_b, GJ, m'), EA = E m'/rho (proposed default)
+# docs/model.md#input-sections: Table 2 (EI_t = EI_b, GJ, m'), EA = E m'/rho (proposed default)
 TABLE2 = ((7.22e8, 5.55e8, 318.86), (6.30e8, 4.85e8, 304.07), (5.46e8, 4.20e8, 289.27))
 Z_C_TABLE2 = (0.045, 0.044, 0.043)          # m, mass centre along e_b (Table 2)
 MAX_BOOMS = 6                               # sections of the longest crane the scenes accept
@@ -57,6 +57,71 @@ def crane_sections(n_booms: int):
             tuple(zc for _, zc in added) + Z_C_TABLE2)
 
 
+@dataclass(frozen=True)
+class BoomSpec:
+    """One boom of a crane described boom by boom (scene ``[[boom]]``), SI units.
+
+    length m; E, G Pa; rho kg/m^3; A m^2; I_t, I_b m^4 (centroidal, bending in and across the
+    luffing plane); J m^4 (torsion constant: the St. Venant constant of the section, or a given
+    value); mass_per_length kg/m (rho A, or a given value that may include fittings); y_c, z_c m
+    (mass centre in the section frame); section: the
+    :class:`~sim_core.physics.cross_sections.CrossSection` (None for given properties)."""
+
+    length: float
+    E: float
+    G: float
+    rho: float
+    A: float
+    I_t: float
+    I_b: float
+    J: float
+    mass_per_length: float
+    y_c: float = 0.0
+    z_c: float = 0.0
+    section: object = None
+
+
+@dataclass(frozen=True)
+class OverlapSpec:
+    """The sliders of one overlap (booms k and k+1, 0-based k), SI units.
+
+    slider_width m (2w, both sliders of the overlap); inner_distance m: the inner-region slider
+    (on boom k+1, bearing inside boom k) sits this far from boom k+1's left end; outer_distance
+    m: the outer-region slider (on boom k, bearing on boom k+1) sits this far from boom k's right
+    end; radial_gap m: sliding-block thickness between the walls; bears_on: names of the inner
+    boom's outer-face patches the sliders bear on (arcs and faces of
+    :func:`sim_core.physics.cross_sections.cross_section`); None: every patch of the shape's
+    default bearing set."""
+
+    slider_width: float = 0.3
+    inner_distance: float = 0.0
+    outer_distance: float = 0.0
+    radial_gap: float = 0.005
+    bears_on: tuple | None = None
+
+
+@dataclass(frozen=True)
+class LuffingSpec:
+    """Mounting points of the luffing cylinder (docs/model.md#input-luffing), m.
+
+    pivot: D1 in global (X, Z); pivot_on_boom: D1 in boom 1's left-section frame (axial s,
+    vertical b); base: the cylinder base D2 in global (X, Z); head_on_boom: the cylinder head D3
+    in boom 1's left-section frame (axial s, vertical b): its axial coordinate is the luffing
+    point L_h, where boom 1's two spline elements meet."""
+
+    pivot: tuple = (-0.556, 0.350)
+    pivot_on_boom: tuple = (-0.956, 0.556)
+    base: tuple = (0.100, 0.050)
+    head_on_boom: tuple = (7.250, -0.556)
+
+    def points(self):
+        """(r1, r2, rbar1, rbar3) as 3-vectors for
+        :func:`sim_core.systems.telescopic.luffing.luffing_geometry`."""
+        (x1, z1), (x2, z2) = self.pivot, self.base
+        (s1, b1), (s3, b3) = self.pivot_on_boom, self.head_on_boom
+        return (x1, 0.0, z1), (x2, 0.0, z2), (s1, 0.0, b1), (s3, 0.0, b3)
+
+
 @dataclass
 class TelescopicParams:
     """Inputs of the paper's telescopic scenes (SI units; defaults = paper Section 9.2)."""
@@ -86,7 +151,7 @@ class TelescopicParams:
     rope_elasticity: bool = True            # elastic tension-only ropes; off = one inextensible rope
     mechanism: str = "synchronized"         # telescoping drive of MECHANISMS (N >= 3)
     flexible: bool = True                   # flexible booms; off = rigid kinematic limit
-    mass_centre_offset: bool = False        # Table 2 z_c as rigid offset (SCENARIOS A1)
+    mass_centre_offset: bool = False        # Table 2 z_c as rigid offset (docs/model.md#input-sections)
     z_c: tuple | None = None                # m, mass centre along e_b (None: crane_sections)
     mu_static: float = 0.15
     mu_dynamic: float = 0.1
@@ -94,33 +159,75 @@ class TelescopicParams:
     moment_model: str = "rigid"             # slider moment: "rigid" (Sec. 6), "seat", "couple"
     seat_stiffness: float = 1e8             # N m/rad, rocking stiffness of a slider seat
     friction_load: str = "resultant"        # friction normal load: "resultant" or "springs"
-    spring_k0: float = 1e9                  # N/m per radial spring (SCENARIOS A6)
+    spring_k0: float = 1e9                  # N/m per radial spring (docs/model.md#input-springs)
     spring_eps: float = 1e-6                # m, smoothing interval
-    slider_width: float = 0.3               # m, 2w: slider length along the boom (SCENARIOS A1)
-    springs_per_quarter: int = 20           # radial springs per quarter arc and slider end (A6)
-    radial_gap: float = 0.005               # m, gap between adjacent booms' walls (A1, Table 1)
+    slider_width: float = 0.3               # m, 2w: slider length along the boom (docs/model.md#input-sections)
+    springs_per_quarter: int = 20           # radial springs per quarter arc and slider end (docs/model.md#input-springs)
+    radial_gap: float = 0.005               # m, gap between adjacent booms' walls (Table 1)
     sections: tuple | None = None           # (EI, GJ, m') per boom (None: crane_sections)
+    booms: tuple | None = None              # BoomSpec per boom ([[boom]]); None: the shorthand
+    lengths: tuple | None = None            # m, per boom (None: boom_length for every boom)
+    overlaps: tuple | None = None           # OverlapSpec per overlap (None: the [contact] values)
+    luffing: LuffingSpec | None = None      # None: the paper's mounting points with L_h
 
     def __post_init__(self):
         if self.mechanism not in MECHANISMS:
             raise ValueError(f"mechanism = {self.mechanism!r}: allowed {MECHANISMS}")
+        if self.booms is not None:
+            if len(self.booms) != self.n_booms:
+                raise ValueError(f"booms: {len(self.booms)} BoomSpec for n_booms = "
+                                 f"{self.n_booms}")
+            self.lengths = tuple(b.length for b in self.booms)
+        if self.lengths is None:
+            self.lengths = (self.boom_length,) * self.n_booms
+        if self.overlaps is None:
+            self.overlaps = (OverlapSpec(self.slider_width, 0.0, 0.0, self.radial_gap),) * \
+                (self.n_booms - 1)
+        if self.luffing is None:
+            self.luffing = LuffingSpec(head_on_boom=(self.L_h, -0.556))
+        self.L_h = float(self.luffing.head_on_boom[0])
+        if self.booms is not None:
+            self.z_c = tuple(b.z_c for b in self.booms)
+            return
         rows, zc = crane_sections(self.n_booms)
         if self.sections is None:
             self.sections = rows
         if self.z_c is None:
             self.z_c = zc
 
+    @property
+    def uniform(self) -> bool:
+        """The paper's kind of crane: the shorthand sections, one length, sliders at the ends."""
+        return (self.booms is None and len(set(self.lengths)) == 1
+                and all(o.inner_distance == 0.0 and o.outer_distance == 0.0
+                        and o.bears_on is None for o in self.overlaps))
+
     def summary(self, name: str = "telescopic") -> dict:
         """What a Result records as its scene where it was run from parameters, not a scene."""
+        skip = ("sections", "booms", "overlaps", "luffing")
         return {"kind": "telescopic", "name": name,
-                "params": {k: v for k, v in self.__dict__.items() if k != "sections"}}
+                "params": {k: v for k, v in self.__dict__.items() if k not in skip}}
 
 
 def boom_section(k: int, p: TelescopicParams) -> BeamSection:
+    """The beam constants of boom k (0-based, from the outermost).
+
+    Described boom by boom: EA = E A, GJ = G J, EI_t = E I_t, EI_b = E I_b (Eq. 36), rhoA = m',
+    rotary inertia (m'/A) (I_t + I_b, I_t, I_b) about (e_s, e_t, e_b).  The shorthand: the rows
+    of :func:`crane_sections` scaled with E (the paper's nearly rigid case 9.1 scales the
+    stiffnesses, not the masses), rotary inertia rho EI/E (docs/model.md#input-sections)."""
+    if p.booms is not None:
+        b = p.booms[k]
+        dens = b.mass_per_length / b.A                   # kg/m^3 of the smeared section
+        off = p.mass_centre_offset
+        return BeamSection(EA=b.E * b.A, GJ=b.G * b.J, EI_t=b.E * b.I_t, EI_b=b.E * b.I_b,
+                           rhoA=b.mass_per_length, J_s=dens * (b.I_t + b.I_b),
+                           J_t=dens * b.I_t, J_b=dens * b.I_b,
+                           y_c=b.y_c if off else 0.0, z_c=b.z_c if off else 0.0)
     EI, GJ, m = p.sections[min(k, len(p.sections) - 1)]
     scale = p.E / 2.1e11                   # case 9.1: stiffnesses x10, masses unchanged
     I = EI / 2.1e11                         # second moment from Table 2
-    # mass-centre offset along e_b (Table 2), a rigid offset in inertia and gravity (A1)
+    # mass-centre offset along e_b (Table 2), a rigid offset in inertia and gravity (#input-sections)
     zc = p.z_c[min(k, len(p.z_c) - 1)] if p.mass_centre_offset else 0.0
     return BeamSection(EA=p.E * m / p.rho, GJ=GJ * scale, EI_t=EI * scale, EI_b=EI * scale,
                        rhoA=m, J_s=2 * p.rho * I, J_t=p.rho * I, J_b=p.rho * I, z_c=zc)

@@ -78,7 +78,8 @@ def plot_telescopic(result: Result, out: str | Path, slider_times=None) -> list[
       every rope;
     * ``slider_contact_forces.png`` (Fig. 26): normal force of every slider spring of every
       region at chosen times (default: t_end / 4, t_end / 2, 0.8 t_end = 16 s of the paper's
-      20 s, t_end), springs numbered arc by arc as in ``sim_core.physics.contact``.
+      20 s, t_end), springs numbered patch by patch (arcs, then faces) as in
+      ``sim_core.physics.contact``; regions with fewer springs are padded with NaN.
     """
     import matplotlib
     matplotlib.use("Agg")
@@ -166,7 +167,7 @@ def plot_telescopic(result: Result, out: str | Path, slider_times=None) -> list[
             ax.set_ylabel(f"{name} [kN]")
             ax.grid(alpha=0.3)
             ax.legend(loc="best", fontsize=7)
-        axes[-1].set_xlabel("spring (arc by arc)")
+        axes[-1].set_xlabel("spring (patch by patch: arcs, then faces)")
         fig.suptitle("normal force of the slider springs")
         fig.tight_layout()
         paths.append(save_figure(fig, out / "slider_contact_forces.png"))

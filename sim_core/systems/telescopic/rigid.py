@@ -2,17 +2,17 @@
 
 The booms are rigid and slide along the common axis e_s of the luffed boom 1, which is held by
 the pivot D1 and the (rigid) luffing cylinder D2-D3.  The telescopic cylinder prescribes the
-piston length L_s(t) (cubic schedule, SCENARIOS A4) and the ropes over the pulley on boom 2 move
-boom 3 (Zhao-Qi-Wang 2024 Section 9, Eqs. 74-76: boom 3 moves twice the piston stroke when the
-ropes are inextensible).  Nothing of the beam model is built: no spline elements, no contact
-constraints, no slider springs.
+piston length L_s(t) (cubic schedule, docs/model.md#input-drive) and the ropes over the pulley
+on boom 2 move boom 3 (Zhao-Qi-Wang 2024 Section 9, Eqs. 74-76: boom 3 moves twice the piston
+stroke when the ropes are inextensible).  Nothing of the beam model is built: no spline
+elements, no contact constraints, no slider springs.
 
 Positions along e_s of the left sections (a_1 = 0, a_2 = L_s(t), a_3):
 
 * ``rope_elasticity = false``: a_3 = 2 a_2 (rope length constant; zero degrees of freedom);
 * ``rope_elasticity = true``: a_3 is the one degree of freedom, driven by the tension-only
-  extraction and retraction ropes of SCENARIOS A3 (same anchors, pulleys, EA and unstretched
-  lengths as :func:`sim_core.systems.telescopic.build.build_telescopic`):
+  extraction and retraction ropes of docs/model.md#input-ropes (same anchors, pulleys, EA and
+  unstretched lengths as :func:`sim_core.systems.telescopic.build.build_telescopic`):
 
       (m_3 + m_p) a_3'' = T_e - T_r - (m_3 + m_p) g sin(theta)
 
@@ -23,9 +23,10 @@ Forces (d'Alembert, frictionless sliding; boom mass centres on the axis, or offs
 e_b with ``mass_centre_offset``, as in the flexible model):
 
 * telescopic cylinder (pushing positive): F_tel = m_2 (a_2'' + g sin theta) + 2 T_e - 2 T_r
-  (axial balance of boom 2; static form SCENARIOS C7: m_2 g sin th + 2 T);
+  (axial balance of boom 2; static form m_2 g sin th + 2 T, docs/model.md#check-static-luffing);
 * luffing cylinder (pushing positive): moment balance of the whole boom set about D1 with the
-  inertia forces -m_k a_k'' e_s added to the weights (static form SCENARIOS C7,
+  inertia forces -m_k a_k'' e_s added to the weights (static form:
+  docs/model.md#check-static-luffing,
   :func:`sim_core.validation.closed_form.static_luffing_forces`).
 
 Supported for 2 or 3 booms (the rope drive is the paper's three-boom drive; with 2 booms there
@@ -45,7 +46,8 @@ from sim_core.systems.telescopic.params import boom_section
 
 # extraction rope: anchor on boom 1 (axial +0.05 m from its left section), pulley on boom 2 at
 # s = 9 m, anchor on boom 3 (-0.04 m); retraction rope: boom 1 right end + 0.68 m, pulley on
-# boom 2 at s = 0.66 m, boom 3 left + 0.64 m (SCENARIOS A3; same points as telescopic.py)
+# boom 2 at s = 0.66 m, boom 3 left + 0.64 m (docs/model.md#input-ropes; same points as
+# telescopic.py)
 _EXT = (0.05, 9.0, -0.04)
 _RET = (0.68, 0.66, 0.64)
 
@@ -68,7 +70,8 @@ class RigidTelescopic:
         self.origin = np.asarray(self.geo.origin, float)
         self.L = p.boom_length
         self.masses = [boom_section(k, p).rhoA * self.L for k in range(p.n_booms)]
-        # mass centres offset along e_b (Table 2, SCENARIOS A1) when switched on
+        # mass centres offset along e_b (Table 2, docs/model.md#input-sections), when
+        # switched on
         self.z_c = [boom_section(k, p).z_c for k in range(p.n_booms)]
         self.e_b = np.asarray(self.geo.rotation, float) @ np.array([0.0, 0.0, 1.0])
         self.schedule = CubicSmoothstepSchedule(v_max=p.v_max, t_ramp=p.t_ramp,
@@ -83,7 +86,7 @@ class RigidTelescopic:
             self.le0 = (Ls + _EXT[1] - _EXT[0]) + (Ls + _EXT[1] - (2 * Ls + _EXT[2]))
             self.lr0 = (self.L + _RET[0] - (Ls + _RET[1])) + (2 * Ls + _RET[2] - (Ls + _RET[1]))
             self.EA = p.rope_EA * p.E / 2.1e11
-            T0 = (self.masses[2] + p.payload) * self.g * math.sin(self.theta)   # C7
+            T0 = (self.masses[2] + p.payload) * self.g * math.sin(self.theta)   # check-static-luffing
             self.Le = self.le0 / (1.0 + T0 / self.EA)
             self.Lr = self.lr0                                                 # just taut
 
@@ -110,7 +113,8 @@ class RigidTelescopic:
     # -- forces -----------------------------------------------------------------------------
     def luffing_force(self, positions, accelerations) -> float:
         """Luffing-cylinder force (N, pushing positive) from the moment balance about D1 of the
-        weights and inertia forces (SCENARIOS C7 with d'Alembert terms)."""
+        weights and inertia forces (docs/model.md#check-static-luffing with d'Alembert
+        terms)."""
         gvec = np.array([0.0, 0.0, -self.g])
         d1 = np.asarray(self.geo.d1, float)
         M = 0.0

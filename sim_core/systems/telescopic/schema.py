@@ -11,7 +11,7 @@
                within (0, length)), E Pa (> 0), rho kg/m^3 (> 0), n_nodes (3..33 per spline
                element; paper 9), n_gauss (1..10)
   [drive]      direction ("extraction"/"retraction"), v_max m/s (> 0), t_ramp s (> 0),
-               t_hold_end s (>= t_ramp)  -- the cubic schedule of Section 9 (SCENARIOS A4);
+               t_hold_end s (>= t_ramp)  -- the cubic schedule of Section 9 (docs/model.md#input-drive);
                mechanism ("synchronized" default: the paper's cylinder-and-rope unit repeated
                along the boom, every stage moves together; "sequential": one cylinder moves
                one stage at a time, the others pinned; docs/model.md, "N-boom drives")
@@ -30,7 +30,7 @@
                false = one inextensible rope constraint, output rope_tension),
                mass_centre_offset (bool, default false: mass on the reference line; true =
                the Table 2 offsets z_c = 0.045/0.044/0.043 m as a rigid offset in inertia and
-               gravity, SCENARIOS A1; the modal ROM tables are built without it)
+               gravity, docs/model.md#input-sections; the modal ROM tables are built without it)
   [contact]    mu_static (>= 0), mu_dynamic (>= 0), v_eps m/s (> 0, switching speed),
                k0 N/m (> 0, radial spring stiffness), eps m (> 0, stiffness smoothing interval),
                slider_width m (2w, > 0 and shorter than the smallest overlap L - max L_s),
@@ -51,20 +51,72 @@
                sim_core.systems.telescopic.modal, tables built from the full model for 3 and 5
                booms, synchronized drive, frictionless), n_modes (1..4, in-plane modes kept by
                the ROM; default 3)
+  [[boom]]     a crane described boom by boom, outermost first (replaces booms.length and the
+               shorthand sections; booms.count, when given, must equal the number of tables):
+               length m (> 0), E Pa (> 0, default booms.E), nu (-1..0.5, default 0.3) or G Pa
+               (> 0), rho kg/m^3 (> 0, default booms.rho), and its section table (below)
+  [boom.section] shape ("u", "box", "polygon", "properties"):
+               "u": top_arc_centre_y m, top_arc_centre_z m (>= 0), top_arc_radius m (> 0, outer
+               radius r of the top arcs), bottom_arc_radius m (outer R = y_a + r, optional),
+               wall m (> 0); "box": width m, height m (> 0), wall m (> 0), corner_radius m
+               (>= 0, outer); "polygon": n_sides (3..24) with width_across_flats m (> 0, even
+               n_sides) or circumradius m (> 0), rotation_deg deg, wall m, or contour (outer
+               vertices [[y, z], ...] in m, counter-clockwise) and wall m; "properties": A m^2,
+               I_t m^4, I_b m^4, J m^4, mass_per_length kg/m (> 0), y_c m, z_c m (mass centre,
+               default 0).  For "u", "box" and
+               "polygon" the constants come from sectionproperties (finite-element section
+               analysis: A, I_t, I_b, the St. Venant constant J, centroid); any of A m^2, I_t
+               m^4, I_b m^4, J m^4, mass_per_length kg/m, y_c m, z_c m given beside the shape
+               replaces the computed value (a mass per length with fittings, say)
+  [[overlap]]  the sliders of each overlap, outermost pair first (all or none):
+               slider_width m (> 0, default contact.slider_width), inner_slider_distance m
+               (>= 0: the inner boom's slider centre from that boom's left end; default 0),
+               outer_slider_distance m (>= 0: the outer boom's slider centre from its right
+               end; default 0), radial_gap m ((0, 0.05], default contact.radial_gap),
+               bears_on (names of the inner boom's outer-face patches the sliders bear on: "u"
+               P1, P2, P3, flange, side_right, side_left; "box" bottom, right, top, left,
+               corner_br, corner_tr, corner_tl, corner_bl; "polygon" face_1..face_n from the
+               bottom face counter-clockwise; default: P1-P3 for "u", every patch otherwise)
+  [luffing]    the luffing cylinder's mounting points (docs/model.md#input-luffing), each [X, Z]
+               or [s, b] in m: pivot m (D1 in global X and Z), pivot_on_boom m (D1 in boom 1's
+               left-section frame: axial and vertical), base m (the cylinder base D2 in global X
+               and Z), head_on_boom m (the cylinder head D3 in boom 1's left-section frame; its
+               axial coordinate is the luffing point L_h; default booms.L_h and -0.556 m)
 Geometry rules: the stroke history must keep each boom inside its neighbour: with L_s(t) the
-piston length, 0 < L_s(t) < length for all t in [0, t_end] (error names drive/booms fields).
+piston length, 0 < L_s(t) < length for all t in [0, t_end] (error names drive/booms fields);
+the two sliders of every overlap fit its shortest length, the inner boom reaches past the outer
+boom's slider, and every inner section fits inside its outer one with the stated radial gap.
 """
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 from sim_core.errors import SceneError
-from sim_core.scene.fields import ERROR_CONTROLLED, boolean, check_keys, choice, number, solver_table
-from sim_core.systems.telescopic.params import MAX_BOOMS, MECHANISMS, TelescopicParams
+from sim_core.scene.fields import (
+    ERROR_CONTROLLED,
+    boolean,
+    check_keys,
+    choice,
+    number,
+    solver_table,
+    table_of,
+    tables_of,
+    vector,
+)
+from sim_core.systems.telescopic.params import (
+    MAX_BOOMS,
+    MECHANISMS,
+    BoomSpec,
+    LuffingSpec,
+    OverlapSpec,
+    TelescopicParams,
+)
 
 _TOP = {"kind", "name", "description", "solver", "booms", "drive", "payload", "ropes", "effects",
-        "filtering", "gravity", "contact", "notes", "model"}
+        "filtering", "gravity", "contact", "notes", "model", "boom", "overlap", "luffing"}
+_GIVEN = ("A", "I_t", "I_b", "J", "mass_per_length", "y_c", "z_c")   # constants a table may give
 
 
 def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
@@ -76,16 +128,36 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
     b = raw.get("booms", {})
     check_keys(b, {"count", "length", "luffing_angle_deg", "stroke0", "L_h", "E", "rho",
                    "n_nodes", "n_gauss"}, "booms")
-    L = number(b, "length", "booms", 10.0, lo=0.0, lo_open=True)
-    sc["booms"] = {"count": number(b, "count", "booms", 3, lo=2, hi=MAX_BOOMS, integer=True),
-                   "length": L,
+    boom_tables = tables_of(raw, "boom")
+    if boom_tables and "length" in b:
+        raise SceneError("booms.length with [[boom]] tables: every [[boom]] gives its own length "
+                         "(allowed: booms.length or [[boom]] lengths, not both)")
+    if boom_tables and b.get("count", len(boom_tables)) != len(boom_tables):
+        raise SceneError(f"booms.count = {b['count']!r} with {len(boom_tables)} [[boom]] tables: "
+                         "the count must equal the number of tables (or be left out)")
+    E = number(b, "E", "booms", 2.1e11, lo=0.0, lo_open=True)
+    rho = number(b, "rho", "booms", 7850.0, lo=0.0, lo_open=True)
+    if boom_tables:
+        sc["boom"] = _check_booms(boom_tables, E, rho)
+        L1, Lmin = sc["boom"][0]["length"], min(x["length"] for x in sc["boom"])
+    else:
+        L1 = Lmin = number(b, "length", "booms", 10.0, lo=0.0, lo_open=True)
+    sc["booms"] = {"count": number(b, "count", "booms", len(boom_tables) or 3, lo=2,
+                                   hi=MAX_BOOMS, integer=True),
                    "luffing_angle_deg": number(b, "luffing_angle_deg", "booms", 60.0, lo=0.0, hi=85.0),
-                   "stroke0": number(b, "stroke0", "booms", 2.0, lo=0.0, hi=L, lo_open=True, hi_open=True),
-                   "L_h": number(b, "L_h", "booms", 7.25, lo=0.0, hi=L, lo_open=True, hi_open=True),
-                   "E": number(b, "E", "booms", 2.1e11, lo=0.0, lo_open=True),
-                   "rho": number(b, "rho", "booms", 7850.0, lo=0.0, lo_open=True),
+                   "stroke0": number(b, "stroke0", "booms", 2.0, lo=0.0, hi=Lmin, lo_open=True,
+                                     hi_open=True),
+                   "L_h": number(b, "L_h", "booms", 7.25, lo=0.0, hi=L1, lo_open=True, hi_open=True),
+                   "E": E, "rho": rho,
                    "n_nodes": number(b, "n_nodes", "booms", 9, lo=3, hi=33, integer=True),
                    "n_gauss": number(b, "n_gauss", "booms", 5, lo=1, hi=10, integer=True)}
+    if not boom_tables:
+        sc["booms"] = {"count": sc["booms"]["count"], "length": L1,
+                       **{k: v for k, v in sc["booms"].items() if k != "count"}}
+    lf = table_of(raw, "luffing", "")
+    if lf:
+        sc["luffing"] = _check_luffing(lf, b, sc["booms"]["L_h"], L1)
+        sc["booms"]["L_h"] = sc["luffing"]["head_on_boom"][0]
     d = raw.get("drive", {})
     check_keys(d, {"direction", "v_max", "t_ramp", "t_hold_end", "mechanism"}, "drive")
     t_ramp = number(d, "t_ramp", "drive", 4.0, lo=0.0, lo_open=True)
@@ -97,9 +169,11 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
     travel = sc["drive"]["v_max"] * sc["drive"]["t_hold_end"]
     sign = 1 if sc["drive"]["direction"] == "extraction" else -1
     end = sc["booms"]["stroke0"] + sign * travel
+    L = Lmin
+    what = "booms.length" if not boom_tables else "the shortest [[boom]] length"
     if not 0.0 < end < L:
         raise SceneError(f"drive: the stroke history moves L_s from {sc['booms']['stroke0']:g} m to "
-                         f"{end:g} m, outside the allowed (0, {L:g}) m (booms.length): a boom would "
+                         f"{end:g} m, outside the allowed (0, {L:g}) m ({what}): a boom would "
                          f"leave its neighbour; reduce drive.v_max or drive.t_hold_end "
                          f"(v_max * t_hold_end <= {(L - sc['booms']['stroke0']) if sign > 0 else sc['booms']['stroke0']:g} m)")
     pl = raw.get("payload", {})
@@ -111,7 +185,7 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
     e = raw.get("effects", {})
     check_keys(e, {"gravity", "filtering", "friction", "contact_distribution", "torsion",
                    "rope_elasticity", "flexible", "mass_centre_offset"}, "effects")
-    three = sc["booms"]["count"] == 3
+    three = sc["booms"]["count"] == 3 or bool(boom_tables)
     sc["effects"] = {"flexible": boolean(e, "flexible", "effects", True),
                      "torsion": boolean(e, "torsion", "effects", True),
                      "gravity": boolean(e, "gravity", "effects", True),
@@ -121,10 +195,12 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
                      "rope_elasticity": boolean(e, "rope_elasticity", "effects", True),
                      "mass_centre_offset": boolean(e, "mass_centre_offset", "effects", False)}
     eff = sc["effects"]
-    if eff["contact_distribution"] and not three:
-        raise SceneError(f"effects.contact_distribution = true with booms.count = "
-                         f"{sc['booms']['count']}: the slider geometry is the paper's three-boom "
-                         "section (allowed: booms.count = 3, or contact_distribution = false)")
+    if boom_tables and not (eff["flexible"]
+                            and raw.get("model", {}).get("reduction", "none") == "none"):
+        raise SceneError("[[boom]] tables with effects.flexible = false or model.reduction = "
+                         "'modal': the rigid limit and the modal tables are built for the paper's "
+                         "crane (allowed: the booms shorthand, or flexible booms with "
+                         "model.reduction = 'none')")
     if not eff["flexible"]:
         if sc["booms"]["count"] not in (2, 3) or sc["drive"]["mechanism"] != "synchronized":
             raise SceneError(f"effects.flexible = false with booms.count = {sc['booms']['count']} "
@@ -170,11 +246,16 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
     # the two sliders of a pair (boom k+1's left-end slider inside boom k, boom k's right-end
     # slider on boom k+1) must fit in the overlap L - L_s(t) at its shortest
     ls_max = max(sc["booms"]["stroke0"], end)
-    overlap = L - ls_max
-    if sc["contact"]["slider_width"] >= overlap:
-        raise SceneError(f"contact.slider_width = {sc['contact']['slider_width']:g} m does not fit "
-                         f"the shortest overlap of adjacent booms, booms.length - max L_s = "
-                         f"{overlap:g} m (allowed: 0 < slider_width < {overlap:g} m)")
+    ls_min = min(sc["booms"]["stroke0"], end)
+    ov = tables_of(raw, "overlap")
+    if ov or boom_tables:
+        sc["overlap"] = _check_overlaps(ov, sc, ls_min, ls_max)
+    else:
+        overlap = L - ls_max
+        if sc["contact"]["slider_width"] >= overlap:
+            raise SceneError(f"contact.slider_width = {sc['contact']['slider_width']:g} m does not "
+                             f"fit the shortest overlap of adjacent booms, booms.length - max L_s "
+                             f"= {overlap:g} m (allowed: 0 < slider_width < {overlap:g} m)")
     f = raw.get("filtering", {})
     check_keys(f, {"h"}, "filtering")
     sc["filtering"] = {"h": number(f, "h", "filtering", 0.01, lo=0.0, lo_open=True)}
@@ -206,11 +287,235 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
     return sc
 
 
+def _check_booms(tables: list, E0: float, rho0: float) -> list[dict]:
+    """The [[boom]] tables, outermost first: length, material and section (its constants
+    computed here, so a bad section fails before the run and the resolved scene records them)."""
+    if not 2 <= len(tables) <= MAX_BOOMS:
+        raise SceneError(f"[[boom]]: {len(tables)} tables, allowed 2..{MAX_BOOMS} booms")
+    out = []
+    for i, t in enumerate(tables):
+        w = f"boom[{i}]"
+        check_keys(t, {"length", "E", "nu", "G", "rho", "section"}, w)
+        if "nu" in t and "G" in t:
+            raise SceneError(f"{w}.nu and {w}.G: give one of the two (G = E / (2 (1 + nu)))")
+        E = number(t, "E", w, E0, lo=0.0, lo_open=True)
+        nu = number(t, "nu", w, 0.3, lo=-1.0, hi=0.5, lo_open=True, hi_open=True)
+        out.append({"length": number(t, "length", w, lo=0.0, lo_open=True), "E": E,
+                    "G": number(t, "G", w, E / (2.0 * (1.0 + nu)), lo=0.0, lo_open=True),
+                    "rho": number(t, "rho", w, rho0, lo=0.0, lo_open=True),
+                    "section": _check_section(table_of(t, "section", w), i)})
+        c = out[-1]["section"]["constants"]
+        if "mass_per_length" not in c:
+            c["mass_per_length"] = out[-1]["rho"] * c["A"]
+    return out
+
+
+def _check_section(t: dict, i: int) -> dict:
+    """The [boom.section] table of boom i: the shape's keys (ranges checked here, the geometry by
+    sim_core.physics.cross_sections) and the constants, computed or given."""
+    w = f"boom[{i}].section"
+    if not t:
+        raise SceneError(f"{w}: missing (required: a table with shape = 'u', 'box', 'polygon' "
+                         "or 'properties')")
+    shape = choice(t, "shape", w, ("u", "box", "polygon", "properties"))
+    given = {k: number(t, k, w, lo=0.0, lo_open=True) for k in ("A", "I_t", "I_b", "J",
+                                                               "mass_per_length") if k in t}
+    for k in ("y_c", "z_c"):
+        if k in t:
+            given[k] = number(t, k, w, lo=-10.0, hi=10.0)
+    if shape == "properties":
+        for k in ("A", "I_t", "I_b", "J", "mass_per_length"):
+            number(t, k, w, lo=0.0, lo_open=True)          # required
+        check_keys(t, {"shape", *_GIVEN}, w)
+        given.setdefault("y_c", 0.0)
+        given.setdefault("z_c", 0.0)
+        spec = {"shape": "properties", **given}
+    else:
+        geo = {k: v for k, v in t.items() if k not in _GIVEN}
+        if shape == "u":
+            check_keys(geo, {"shape", "top_arc_centre_y", "top_arc_centre_z", "top_arc_radius",
+                             "bottom_arc_radius", "wall"}, w)
+            for k in ("top_arc_centre_y", "top_arc_centre_z"):
+                number(t, k, w, lo=0.0)
+            number(t, "top_arc_radius", w, lo=0.0, lo_open=True)
+            if "bottom_arc_radius" in t:
+                number(t, "bottom_arc_radius", w, lo=0.0, lo_open=True)
+        elif shape == "box":
+            check_keys(geo, {"shape", "width", "height", "wall", "corner_radius"}, w)
+            for k in ("width", "height"):
+                number(t, k, w, lo=0.0, lo_open=True)
+            if "corner_radius" in t:
+                number(t, "corner_radius", w, lo=0.0)
+        else:
+            check_keys(geo, {"shape", "n_sides", "width_across_flats", "circumradius",
+                             "rotation_deg", "contour", "wall"}, w)
+            if "contour" not in t:
+                number(t, "n_sides", w, lo=3, hi=24, integer=True)
+                for k in ("width_across_flats", "circumradius"):
+                    if k in t:
+                        number(t, k, w, lo=0.0, lo_open=True)
+                if "rotation_deg" in t:
+                    number(t, "rotation_deg", w, lo=-180.0, hi=180.0)
+        number(t, "wall", w, lo=0.0, lo_open=True)
+        spec = dict(geo)
+    cs = cross_section_of({**spec, "_where": w})
+    constants = {"A": cs.A, "I_t": cs.I_t, "I_b": cs.I_b, "J": cs.J, "y_c": cs.y_c,
+                 "z_c": cs.z_c}
+    if cs.mass_per_length is not None:
+        constants["mass_per_length"] = cs.mass_per_length
+    constants.update(given)
+    for k in ("y_c", "z_c"):                            # round-off of a symmetric section
+        if abs(constants[k]) < 1e-12:
+            constants[k] = 0.0
+    if constants["y_c"] != 0.0:
+        raise SceneError(f"{w}: mass centre y_c = {constants['y_c']:g} m off the luffing plane; "
+                         "the booms' sections must be symmetric about it (allowed: y_c = 0)")
+    return {**spec, "constants": {k: float(v) for k, v in constants.items()},
+            "method": cs.method}
+
+
+def cross_section_of(spec: dict):
+    """The CrossSection of a section table (sim_core.physics.cross_sections; cached there)."""
+    from sim_core.physics.cross_sections import cross_section
+    spec = {k: v for k, v in spec.items() if k not in ("constants", "method")}
+    return cross_section(spec)
+
+
+def _check_luffing(t: dict, booms: dict, L_h: float, L1: float) -> dict:
+    """The [luffing] table: the mounting points D1, D2, D3 (docs/model.md#input-luffing)."""
+    check_keys(t, {"pivot", "pivot_on_boom", "base", "head_on_boom"}, "luffing")
+    out = {"pivot": vector(t, "pivot", "luffing", [-0.556, 0.350], n=2),
+           "pivot_on_boom": vector(t, "pivot_on_boom", "luffing", [-0.956, 0.556], n=2),
+           "base": vector(t, "base", "luffing", [0.100, 0.050], n=2),
+           "head_on_boom": vector(t, "head_on_boom", "luffing", [L_h, -0.556], n=2)}
+    s3 = out["head_on_boom"][0]
+    if "L_h" in booms and "head_on_boom" in t and s3 != L_h:
+        raise SceneError(f"luffing.head_on_boom[0] = {s3:g} m and booms.L_h = {L_h:g} m: both "
+                         "place the cylinder head on boom 1 (allowed: equal, or give one)")
+    if not 0.0 < s3 < L1:
+        raise SceneError(f"luffing.head_on_boom[0] = {s3:g} m: out of range, allowed (0, {L1:g}) "
+                         "m (on boom 1, whose length is the upper bound)")
+    from sim_core.systems.telescopic.luffing import luffing_geometry
+    spec = LuffingSpec(**{k: tuple(v) for k, v in out.items()})
+    theta = math.radians(booms.get("luffing_angle_deg", 60.0))
+    geo = luffing_geometry(theta, *spec.points())
+    if geo.cylinder_length < 0.1 or geo.lever < 0.01:
+        raise SceneError(f"luffing: the cylinder D2-D3 is {geo.cylinder_length:.3g} m long with a "
+                         f"lever of {geo.lever:.3g} m about the pivot D1 at "
+                         f"{math.degrees(theta):g} deg: it cannot hold the boom (allowed: a "
+                         "cylinder of at least 0.1 m with a lever of at least 0.01 m)")
+    return out
+
+
+def _check_overlaps(tables: list, sc: dict, ls_min: float, ls_max: float) -> list[dict]:
+    """The [[overlap]] tables (or their defaults), one per pair of adjacent booms, outermost
+    first, with the fit of the sliders over the stroke history and of the sections."""
+    n = sc["booms"]["count"]
+    c = sc["contact"]
+    if tables and len(tables) != n - 1:
+        raise SceneError(f"[[overlap]]: {len(tables)} tables for {n} booms, allowed {n - 1} (one "
+                         "per pair of adjacent booms, outermost first) or none")
+    booms = sc.get("boom")
+    lengths = [x["length"] for x in booms] if booms else [sc["booms"]["length"]] * n
+    out = []
+    for k in range(n - 1):
+        t = tables[k] if tables else {}
+        w = f"overlap[{k}]"
+        check_keys(t, {"slider_width", "inner_slider_distance", "outer_slider_distance",
+                       "radial_gap", "bears_on"}, w)
+        o = {"slider_width": number(t, "slider_width", w, c["slider_width"], lo=0.0,
+                                    lo_open=True),
+             "inner_slider_distance": number(t, "inner_slider_distance", w, 0.0, lo=0.0),
+             "outer_slider_distance": number(t, "outer_slider_distance", w, 0.0, lo=0.0),
+             "radial_gap": number(t, "radial_gap", w, c["radial_gap"], lo=0.0, hi=0.05,
+                                  lo_open=True),
+             "bears_on": None}
+        Lo, Li = lengths[k], lengths[k + 1]
+        sw, d_in, d_out = o["slider_width"], o["inner_slider_distance"], o["outer_slider_distance"]
+        room = (Lo - d_out) - (ls_max + d_in)
+        if sw >= room:
+            raise SceneError(f"{w}.slider_width = {sw:g} m does not fit the shortest overlap of "
+                             f"booms {k + 1} and {k + 2}: the slider centres are {room:g} m apart "
+                             f"at L_s = {ls_max:g} m (allowed: 0 < slider_width < {max(room, 0):g} "
+                             "m; shorten the slider, move it or reduce the stroke)")
+        reach = Li - (Lo - d_out - ls_min)
+        if reach <= 0.5 * sw:
+            raise SceneError(f"boom[{k + 1}].length = {Li:g} m: at L_s = {ls_min:g} m boom {k + 2} "
+                             f"ends {reach:g} m past the slider of boom {k + 1} (allowed: more "
+                             f"than half the slider width, {0.5 * sw:g} m; lengthen boom {k + 2} "
+                             f"or set {w}.outer_slider_distance)")
+        if "bears_on" in t:
+            v = t["bears_on"]
+            if not (isinstance(v, list) and v and all(isinstance(x, str) for x in v)):
+                raise SceneError(f"{w}.bears_on = {v!r}: must be a non-empty list of patch names")
+            o["bears_on"] = list(v)
+        if booms:
+            _check_fit(booms[k], booms[k + 1], o, k, sc["effects"]["contact_distribution"])
+        elif o["bears_on"] is not None:
+            raise SceneError(f"{w}.bears_on with the booms shorthand: the paper's sliders bear on "
+                             "the arcs P1-P3 (allowed: describe the booms with [[boom]] tables)")
+        out.append(o)
+    return out
+
+
+def _check_fit(outer: dict, inner: dict, o: dict, k: int, distribution: bool) -> None:
+    """The inner section fits inside the outer one with the stated gap, and the sliders' patches
+    exist and hold the section in every transverse direction."""
+    from sim_core.physics.cross_sections import clearance
+    w = f"overlap[{k}]"
+    if outer["section"]["shape"] == "properties" or inner["section"]["shape"] == "properties":
+        if distribution:
+            raise SceneError(f"effects.contact_distribution = true with boom[{k}] or boom[{k + 1}] "
+                             "given by section properties: the slider springs need the section "
+                             "contour (allowed: shape 'u', 'box' or 'polygon', or "
+                             "contact_distribution = false)")
+        return
+    co, ci = cross_section_of(outer["section"]), cross_section_of(inner["section"])
+    gap = clearance(co, ci)
+    # 0.1 mm: the arcs of the contours are polygons in the clearance (a sagitta below 0.1 mm)
+    if gap < o["radial_gap"] - 1e-4:
+        where = (f"the walls are {gap:.4g} m apart at the closest" if gap >= 0 else
+                 f"the walls overlap by {-gap:.4g} m")
+        raise SceneError(f"boom[{k + 1}].section does not fit inside boom[{k}].section with "
+                         f"{w}.radial_gap = {o['radial_gap']:g} m: {where} (allowed: radial_gap "
+                         f"<= {max(gap, 0):.4g} m, or a smaller inner section)")
+    names = [pt[1] for pt in ci.patches]
+    chosen = o["bears_on"]
+    if chosen is not None:
+        bad = [x for x in chosen if x not in names]
+        if bad:
+            raise SceneError(f"{w}.bears_on: {bad[0]!r} is no patch of boom[{k + 1}]'s "
+                             f"{inner['section']['shape']!r} section (allowed: "
+                             f"{', '.join(names)})")
+    from sim_core.systems.telescopic.sliders import patches_hold, bearing_patches
+    if distribution and not patches_hold(bearing_patches(ci, chosen)):
+        raise SceneError(f"{w}.bears_on = {chosen!r}: the sliders' faces leave a transverse "
+                         "direction unsupported (allowed: patches whose normals surround the "
+                         "section, e.g. all faces)")
+
+
 def params_from_scene(sc: dict):
     """TelescopicParams of a validated telescopic scene."""
     b, d = sc["booms"], sc["drive"]
+    booms = None
+    if sc.get("boom"):
+        booms = tuple(BoomSpec(length=x["length"], E=x["E"], G=x["G"], rho=x["rho"],
+                               section=None if x["section"]["shape"] == "properties"
+                               else cross_section_of(x["section"]), **x["section"]["constants"])
+                      for x in sc["boom"])
+    overlaps = None
+    if sc.get("overlap"):
+        overlaps = tuple(OverlapSpec(o["slider_width"], o["inner_slider_distance"],
+                                     o["outer_slider_distance"], o["radial_gap"],
+                                     None if o["bears_on"] is None else tuple(o["bears_on"]))
+                         for o in sc["overlap"])
+    luffing = None
+    if sc.get("luffing"):
+        luffing = LuffingSpec(**{k: tuple(v) for k, v in sc["luffing"].items()})
     return TelescopicParams(
-        n_booms=b["count"], boom_length=b["length"], luffing_angle_deg=b["luffing_angle_deg"],
+        booms=booms, overlaps=overlaps, luffing=luffing,
+        n_booms=b["count"], boom_length=b.get("length", booms[0].length if booms else 10.0),
+        luffing_angle_deg=b["luffing_angle_deg"],
         stroke0=b["stroke0"], direction=1 if d["direction"] == "extraction" else -1, L_h=b["L_h"],
         E=b["E"], rho=b["rho"], payload=sc["payload"]["mass"], rope_EA=sc["ropes"]["EA"],
         gravity=sc["gravity"]["g"] if sc["effects"]["gravity"] else 0.0, n_nodes=b["n_nodes"],
