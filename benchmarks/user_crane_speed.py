@@ -262,6 +262,8 @@ def main(argv: list[str] | None = None) -> int:
             f"{_stats([s.get('n_rhs') for s in sums], 'd')} | "
             f"{', '.join(str(e) for e in sorted({r['exit'] for r in rows}))} |")
     lines += ["", ("RTF = simulated time / median wall time of the whole command (start-up, "
+                   "the section constants (from the on-disk cache of "
+                   "`sim_core.physics.cross_sections`, filled by a run before the benchmark), "
                    "building the model, the integration, writing the results and, in "
                    "`default`, the figures); sim RTF = the integration's own (summary.json "
                    "`real_time_factor`).")]

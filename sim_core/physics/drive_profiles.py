@@ -250,6 +250,236 @@ class Eq52Profile(_PiecewiseProfile):
         return s, v, a, j
 
 
+@dataclass(frozen=True)
+class HoldProfile(_PiecewiseProfile):
+    """An actuator that holds its position s0 (no profile given): v = a = j = 0."""
+
+    s0: float = 0.0
+    sign: int = 1
+    t_start: float = 0.0
+
+    @property
+    def t_end(self) -> float:
+        return self.t_start
+
+    def _unit(self, tl):
+        z = np.zeros_like(tl)
+        return z, z, z, z
+
+    def _unit_scalar(self, tl):
+        return 0.0, 0.0, 0.0, 0.0
+
+
+class _JerkSegments:
+    """Exact evaluation of a motion made of segments of constant jerk (durations d_i >= 0,
+    jerks j_i): a, v, s are the exact integrals from rest at s = 0 (piecewise cubic s)."""
+
+    def _build(self, durations, jerks):
+        knots = [0.0]
+        state = [(0.0, 0.0, 0.0)]                         # (s, v, a) at each knot
+        for d, j in zip(durations, jerks):
+            s, v, a = state[-1]
+            state.append((s + v * d + a * d * d / 2 + j * d ** 3 / 6, v + a * d + j * d * d / 2,
+                          a + j * d))
+            knots.append(knots[-1] + d)
+        object.__setattr__(self, "_knots", np.array(knots))
+        object.__setattr__(self, "_state", np.array(state))
+        object.__setattr__(self, "_jerks", np.array(list(jerks) + [0.0]))
+
+    def _unit(self, tl):
+        tl = np.asarray(tl, dtype=float)
+        k = np.clip(np.searchsorted(self._knots, tl, side="right") - 1, 0, len(self._knots) - 1)
+        dt = np.where(tl < 0, 0.0, tl - self._knots[k])
+        s0, v0, a0 = (self._state[k, i] for i in range(3))
+        j = np.where((tl < 0) | (k == len(self._knots) - 1), 0.0, self._jerks[k])
+        a0 = np.where(k == len(self._knots) - 1, 0.0, a0)
+        v0 = np.where(k == len(self._knots) - 1, 0.0, v0)
+        s = s0 + v0 * dt + a0 * dt * dt / 2 + j * dt ** 3 / 6
+        return (np.where(tl < 0, 0.0, s), np.where(tl < 0, 0.0, v0 + a0 * dt + j * dt * dt / 2),
+                np.where(tl < 0, 0.0, a0 + j * dt), j)
+
+
+@dataclass(frozen=True)
+class TrapezoidProfile(_JerkSegments, _PiecewiseProfile):
+    """Point-to-point move of ``travel`` (m or rad, > 0) with the rate limited to v_max and the
+    acceleration to a_max, optionally with the jerk limited to j_max (an S-curve); sign +-1
+    gives the direction, s0 the start, t_start the start time.
+
+    Without j_max the acceleration is +a_max, 0, -a_max (v trapezoidal, or triangular where
+    the travel is too short to reach v_max); with j_max each acceleration change is a ramp of
+    jerk +-j_max (seven phases: jerk up, constant acceleration, jerk down, cruise and the
+    mirrored braking; the constant-acceleration phase vanishes where v_max < a_max^2 / j_max,
+    and the peak rate drops below v_max where the travel is short).  Standard point-to-point
+    motion law of drives (Biagiotti and Melchiorri, "Trajectory Planning for Automatic
+    Machines and Robots", Springer 2008, Sections 3.2-3.4); evaluated exactly as segments of
+    constant jerk."""
+
+    travel: float = 1.0
+    v_max: float = 0.5
+    a_max: float = 0.25
+    j_max: float | None = None
+    sign: int = 1
+    s0: float = 0.0
+    t_start: float = 0.0
+
+    def __post_init__(self) -> None:
+        _check("travel", self.travel, self.travel > 0, "travel > 0 (finite)")
+        _check("v_max", self.v_max, self.v_max > 0, "v_max > 0 (finite)")
+        _check("a_max", self.a_max, self.a_max > 0, "a_max > 0 (finite)")
+        if self.j_max is not None:
+            _check("j_max", self.j_max, self.j_max > 0, "j_max > 0 (finite)")
+        _check("sign", self.sign, self.sign in (1, -1), "+1 or -1")
+        D = self.travel
+
+        def accel_phase(v):              # (durations, jerks, time) of reaching rate v from rest
+            if self.j_max is None:
+                return [v / self.a_max], [None], v / self.a_max
+            ap = min(self.a_max, math.sqrt(v * self.j_max))
+            tj = ap / self.j_max
+            ta = v / ap - tj
+            return [tj, ta, tj], [self.j_max, 0.0, -self.j_max], 2 * tj + ta
+
+        v = self.v_max
+        if v * accel_phase(v)[2] > D:     # v_max not reached: the peak rate by bisection
+            lo, hi = 0.0, v
+            for _ in range(200):
+                mid = 0.5 * (lo + hi)
+                lo, hi = (mid, hi) if mid * accel_phase(mid)[2] <= D else (lo, mid)
+            v = lo
+        d_acc, j_acc, t_acc = accel_phase(v)
+        cruise = max(D / v - t_acc, 0.0)
+        if self.j_max is None:              # constant-acceleration phases as infinite jerk:
+            object.__setattr__(self, "_trap", (t_acc, cruise, v))   # evaluated in closed form
+        else:
+            object.__setattr__(self, "_trap", None)
+            self._build(d_acc + [cruise] + d_acc[::-1],
+                        j_acc + [0.0] + [-x for x in j_acc[::-1]])
+        object.__setattr__(self, "v_peak", v)
+
+    @property
+    def t_end(self) -> float:
+        if self._trap is not None:
+            ta, tc, _ = self._trap
+            return self.t_start + 2 * ta + tc
+        return self.t_start + float(self._knots[-1])
+
+    def _unit(self, tl):
+        if self._trap is None:
+            return _JerkSegments._unit(self, tl)
+        ta, tc, v = self._trap
+        a = v / ta
+        tl = np.asarray(tl, dtype=float)
+        t1, t2, t3 = ta, ta + tc, 2 * ta + tc
+        s = np.select([tl < 0, tl < t1, tl < t2, tl < t3],
+                      [0.0, a * tl ** 2 / 2, v * ta / 2 + v * (tl - t1),
+                       v * ta / 2 + v * tc + v * (tl - t2) - a * (tl - t2) ** 2 / 2],
+                      default=v * ta + v * tc)
+        vel = np.select([tl < 0, tl < t1, tl < t2, tl < t3], [0.0, a * tl, v, v - a * (tl - t2)],
+                        default=0.0)
+        acc = np.select([tl < 0, tl < t1, tl < t2, tl < t3], [0.0, a, 0.0, -a], default=0.0)
+        return s, vel, acc, np.zeros_like(tl)
+
+
+class TableProfile(_PiecewiseProfile):
+    """A measured or planned history (t_i, s_i) of an actuator, interpolated by the monotone
+    piecewise cubic Hermite interpolant of Fritsch and Carlson (1980, SIAM J. Numer. Anal. 17,
+    238-246; scipy.interpolate.PchipInterpolator's slopes): s is C^1 (the rate is continuous),
+    the acceleration is piecewise linear and bounded, and the interpolant does not overshoot
+    between samples (a monotone stretch of the table stays monotone).  The slopes at the first
+    and last sample are zero: the actuator holds s_0 before the table and s_n after it, so the
+    rate is continuous there too.
+
+    ``max_rate`` and ``max_accel`` (with the times where they occur) are the interpolant's
+    largest |v| and |a|, exact: a is linear on every piece (its extremes at the samples), v
+    quadratic (its extremes at the samples or at the vertex inside a piece)."""
+
+    sign = 1
+    t_start = 0.0
+
+    def __init__(self, t, s):
+        from scipy.interpolate import CubicHermiteSpline, PchipInterpolator
+        t = np.asarray(t, dtype=float)
+        s = np.asarray(s, dtype=float)
+        if t.ndim != 1 or t.shape != s.shape or t.size < 2:
+            raise SceneError(f"table: {t.size} times and {s.size} positions; allowed: two or "
+                             "more rows of (time, position)")
+        if not (np.all(np.isfinite(t)) and np.all(np.isfinite(s))):
+            raise SceneError("table: a time or position is not finite (NaN/inf not allowed)")
+        bad = np.nonzero(np.diff(t) <= 0)[0]
+        if bad.size:
+            k = int(bad[0])
+            raise SceneError(f"table: time {t[k + 1]:g} s at row {k + 1} does not increase "
+                             f"after {t[k]:g} s (allowed: strictly increasing times)")
+        slopes = (PchipInterpolator(t, s).derivative()(t) if t.size > 2
+                  else np.full(2, (s[1] - s[0]) / (t[1] - t[0])))
+        slopes[0] = slopes[-1] = 0.0
+        self._spline = CubicHermiteSpline(t, s, slopes)
+        self._d = [self._spline.derivative(k) for k in (1, 2, 3)]
+        self.t_table, self.s_table = t, s
+        self.s0 = float(s[0])
+        # largest |a|: at the ends of the pieces (one-sided values)
+        c = self._spline.c                      # (4, pieces): s = c0 dt^3 + c1 dt^2 + c2 dt + c3
+        h = np.diff(t)
+        a_left, a_right = 2 * c[1], 6 * c[0] * h + 2 * c[1]
+        ends = np.concatenate([a_left, a_right])
+        k = int(np.argmax(np.abs(ends)))
+        self.max_accel = float(abs(ends[k]))
+        self.t_max_accel = float(t[k] if k < h.size else t[k - h.size + 1])
+        # largest |v|: at the samples or at the vertex of a piece's quadratic rate
+        cand_t = list(t)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            tv = -c[1] / (3 * c[0])
+        for i in range(h.size):
+            if c[0, i] != 0 and 0 < tv[i] < h[i]:
+                cand_t.append(t[i] + tv[i])
+        cand_t = np.array(cand_t)
+        vv = np.abs(self._d[0](cand_t))
+        k = int(np.argmax(vv))
+        self.max_rate, self.t_max_rate = float(vv[k]), float(cand_t[k])
+
+    @property
+    def t_end(self) -> float:
+        return float(self.t_table[-1])
+
+    def _unit(self, tl):
+        tl = np.asarray(tl, dtype=float)
+        tc = np.clip(tl, self.t_table[0], self.t_table[-1])
+        inside = (tl >= self.t_table[0]) & (tl <= self.t_table[-1])
+        s = self._spline(tc) - self.s0
+        v, a, j = (np.where(inside, d(tc), 0.0) for d in self._d)
+        return s, v, a, j
+
+    def _unit_scalar(self, tl):
+        s, v, a, j = self._unit(np.array(tl))
+        return float(s), float(v), float(a), float(j)
+
+
+def read_table_csv(path) -> tuple[np.ndarray, np.ndarray]:
+    """(t, s) of a CSV file of two columns, time (s) and position; a first line that is not
+    numeric is a header, and lines starting with '#' are comments."""
+    rows = []
+    with open(path, encoding="utf-8") as f:
+        for i, line in enumerate(f):
+            text = line.strip()
+            if not text or text.startswith("#"):
+                continue
+            parts = [x.strip() for x in text.replace(";", ",").split(",")]
+            try:
+                vals = [float(x) for x in parts]
+            except ValueError:
+                if not rows:
+                    continue                      # the header
+                raise SceneError(f"{path}: line {i + 1} is not two numbers: {text!r}") from None
+            if len(vals) != 2:
+                raise SceneError(f"{path}: line {i + 1} has {len(vals)} columns; allowed: two "
+                                 "(time s, position)")
+            rows.append(vals)
+    if len(rows) < 2:
+        raise SceneError(f"{path}: {len(rows)} rows of (time, position); allowed: two or more")
+    a = np.array(rows)
+    return a[:, 0], a[:, 1]
+
+
 def sleeve_motion(bc: dict, s0: float = 0.0):
     """t -> (s, s_dot, s_ddot) of a sleeve end's material coordinate (m, m/s, m/s^2) from its
     validated ``[[boundary]]`` entry (sim_core.scene.io): profile "constant" moves at ``speed``
