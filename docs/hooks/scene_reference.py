@@ -232,6 +232,12 @@ class _Walker(ast.NodeVisitor):
             # the registry goes down with the walk, so a _check helper may call another
             sub = _Walker(self.modules, self.funcs, mod_consts, self.out,
                           params=[a.arg for a in fn.args.args])
+            # a table path passed as an argument (``_check_actuator(d, "luffing_drive")``)
+            # names the table of the keys the helper checks: one walk per call
+            for formal, actual in zip(fn.args.args, node.args):
+                path = self.path_of(actual)
+                if path is not None and re.fullmatch(r"[\w.\[\]{}]*", path):
+                    sub.env[formal.arg] = ("path", path)
             for s in fn.body:
                 sub.visit(s)
         self.generic_visit(node)

@@ -353,7 +353,7 @@ class TrapezoidProfile(_JerkSegments, _PiecewiseProfile):
         else:
             object.__setattr__(self, "_trap", None)
             self._build(d_acc + [cruise] + d_acc[::-1],
-                        j_acc + [0.0] + [-x for x in j_acc[::-1]])
+                        j_acc + [0.0] + [-x for x in j_acc])
         object.__setattr__(self, "v_peak", v)
 
     @property

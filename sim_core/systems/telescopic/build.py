@@ -49,10 +49,11 @@ from sim_core.physics.constraints import (
     point_coincidence,
     rope_length,
 )
-from sim_core.physics.drive_profiles import CubicSmoothstepSchedule
+from sim_core.physics.drive_profiles import CubicSmoothstepSchedule, HoldProfile
+from sim_core.physics.hoist import HangingMass, HoistRope, free_point
 from sim_core.physics.effects import Effect, Elasticity, Gravity, Inertia, StressFilter
 from sim_core.physics.point_effects import PointMass, RopeDrive, SliderSeat
-from sim_core.systems.telescopic.luffing import luffing_geometry
+from sim_core.systems.telescopic.luffing import cylinder_drive, luffing_geometry
 from sim_core.systems.telescopic.params import TelescopicParams, boom_section
 from sim_core.systems.telescopic.sliders import slider_geometries
 
@@ -75,6 +76,8 @@ class TelescopicSystem:
     drives: list = field(default_factory=list)  # names of the prescribed-distance rows
     ropes: list = field(default_factory=list)   # (extraction, retraction) RopeDrive per unit
     stages: list = field(default_factory=list)  # schedule of each stage k (boom k -> k+1)
+    hoist: object = None                        # physics.hoist.HoistRope (payload_swing)
+    slew_angle: object = None                   # t -> slew angle (rad) where the crane slews
 
 
 def drive_layout(n_booms: int, mechanism: str) -> tuple[list[int], list[int]]:
@@ -118,7 +121,8 @@ def rope_static_tension(p: TelescopicParams, j: int) -> float:
     T_j = W_j + F - T_(j+2) = W_j + W_(j+1) + T_(j+2), which sums from the tip to the formula
     (docs/model.md, "N-boom drives")."""
     masses = [p.lengths[i] * boom_section(i, p).rhoA for i in range(p.n_booms)]
-    return (sum(masses[j:]) + p.payload) * p.gravity * math.sin(math.radians(p.luffing_angle_deg))
+    hanging = p.payload + (p.hook_mass if p.payload_swing else 0.0)
+    return (sum(masses[j:]) + hanging) * p.gravity * math.sin(math.radians(p.luffing_angle_deg))
 
 
 def stage_schedules(p: TelescopicParams) -> list[CubicSmoothstepSchedule]:
@@ -129,6 +133,8 @@ def stage_schedules(p: TelescopicParams) -> list[CubicSmoothstepSchedule]:
     of its neighbour, then inwards), retraction the reverse order; a stage outside its window
     holds its length (a locked pin)."""
     n = p.n_booms - 1
+    if p.drive_profile is not None:               # a [drive] profile (actuators): every stage
+        return [p.drive_profile] * n
     if p.mechanism != "sequential":
         one = CubicSmoothstepSchedule(v_max=p.v_max, t_ramp=p.t_ramp, t_hold_end=p.t_hold_end,
                                       sign=p.direction, s0=p.stroke0)
@@ -190,7 +196,9 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
     lin.append(fix_material_coordinate(offsets, beams, 0, 1, p.L_h))
     if not p.torsion:
         lin.append(no_torsion(offsets, beams))
-    model = Model(beams, effects, [], lin, n_extra=N - 1, baumgarte=p.baumgarte)
+    # extra coordinates: the inner contact points s_2,k, then the swinging payload's position
+    n_extra = N - 1 + (3 if p.payload_swing else 0)
+    model = Model(beams, effects, [], lin, n_extra=n_extra, baumgarte=p.baumgarte)
 
     # initial straight configuration: boom k's left section a_k = k L_s along boom 1
     # (docs/model.md#input-ropes)
@@ -230,7 +238,12 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
     # luffing cylinder: rigid massless rod D2-D3 held at its initial length (docs/model.md#input-luffing)
     D3 = mp(0, s_fixed=p.L_h, offset=(0.0, 0.0, rbar3[2]))
     Lc = float(geo.cylinder_length)
-    add(distance_driver("luffing_cylinder", D3, fixed_point(geo.d2), lambda t: (Lc, 0.0, 0.0)))
+    if p.luffing_profile is None:
+        add(distance_driver("luffing_cylinder", D3, fixed_point(geo.d2),
+                            lambda t: (Lc, 0.0, 0.0)))
+    else:          # the cylinder length that moves the rigid crane along the luffing profile
+        add(distance_driver("luffing_cylinder", D3, fixed_point(geo.d2),
+                            cylinder_drive(p.luffing_profile, p.luffing.points())))
     # contact constraints I and II between adjacent booms (Section 6).  The moment model decides
     # which Cardan-angle rows stay constraints: all three (rigid, Eqs. 47-48), or the twist only
     # (seat: the bending rows become an elastic seat; couple: they are free)
@@ -256,8 +269,9 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
                        mp(k + 1, s_index=s3_index[k + 1]))
     # the drive: telescopic cylinders (prescribed distances of left sections, docs/model.md#input-drive) and rope
     # units (module docstring, "N-boom drives")
-    sched = CubicSmoothstepSchedule(v_max=p.v_max, t_ramp=p.t_ramp, t_hold_end=p.t_hold_end,
-                                    sign=p.direction, s0=Ls)
+    sched = p.drive_profile or CubicSmoothstepSchedule(v_max=p.v_max, t_ramp=p.t_ramp,
+                                                       t_hold_end=p.t_hold_end,
+                                                       sign=p.direction, s0=Ls)
     stages = stage_schedules(p)
     cylinders, rope_booms = drive_layout(N, p.mechanism)
     drives = []
@@ -274,7 +288,19 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
 
     tip = mp(N - 1, s_fixed=Lk[N - 1])
     pe = []
-    if p.payload > 0:
+    hoist = None
+    if p.payload_swing:
+        # the payload and hook on the hoist rope (sim_core.physics.hoist): their position is
+        # three coordinates after the contact points, starting below the tip on the rope
+        # stretched by their weight (the statics take it from there)
+        ip = n_beam + N - 1
+        m_hang = p.payload + p.hook_mass
+        L0 = p.hoist_profile or HoldProfile(s0=p.hoist_length)
+        L_static = L0.sample(0.0).s * (1.0 + m_hang * p.gravity / p.hoist_EA)
+        Q0[ip:ip + 3] = np.real(tip(Q0)[0]) - np.array([0.0, 0.0, L_static])
+        hoist = HoistRope(tip, free_point(ip, model.n_coords), p.hoist_EA, _length_of(L0))
+        pe += [HangingMass(ip, m_hang, g_vec if p.gravity > 0 else None), hoist]
+    elif p.payload > 0:
         pe.append(PointMass(tip, p.payload, g_vec if p.gravity > 0 else None))
     ropes = []
     for j in rope_booms:
@@ -310,7 +336,7 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
     model.point_effects = pe + list(seats.values())
     ts = TelescopicSystem(model, Q0, sched, s2_index, s3_index, rows, tip, p,
                           angle_rows=angle_rows, seats=seats, drives=drives, ropes=ropes,
-                          stages=stages)
+                          stages=stages, hoist=hoist)
     # Section 8 contact analysis: the slider springs on every overlap's bearing patches
     # (sim_core.systems.telescopic.sliders); with friction off it is only evaluated for the
     # outputs (it does not act on the motion), with contact_distribution off it is not built
@@ -331,6 +357,19 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
     if p.friction:
         model.multiplier_forces = [ts.contact]
     return ts
+
+
+def _payload_outputs(ts: TelescopicSystem, t: float, Q, r_tip, out: dict) -> None:
+    """payload_position (m), sway_angle (rad: from the vertical in the luffing plane and across
+    it, the plane turned by the slew angle) and hoist_rope_force (N) at one output time."""
+    r_p = np.real(ts.hoist.bottom(Q)[0])
+    d = r_p - np.real(r_tip)
+    phi = ts.slew_angle(t) if ts.slew_angle is not None else 0.0
+    u = np.array([math.cos(phi), math.sin(phi), 0.0])
+    w = np.array([-math.sin(phi), math.cos(phi), 0.0])
+    out.setdefault("payload_position", []).append(r_p)
+    out.setdefault("sway_angle", []).append([math.atan2(d @ u, -d[2]), math.atan2(d @ w, -d[2])])
+    out.setdefault("hoist_rope_force", []).append(ts.hoist.tension(float(np.linalg.norm(d)), t))
 
 
 def _rows(c: NonlinearConstraint, keep: list[int]) -> NonlinearConstraint:
@@ -483,8 +522,10 @@ def _telescopic_result(ts: TelescopicSystem, t, ys, stats, error, scene=None):
                            "contact_point_forces", "inner_contact_s", "outer_contact_s",
                            "constraint_violation", "stage_stroke", "drive_forces")}
     from sim_core.physics.contact.friction import region_multipliers, section_reaction
+    from sim_core.physics.beam.cardan import cardan_frame
     basis = m.beams[0].reference_basis
     lefts = [material_point(m, k, s_fixed=0.0) for k in range(N)]
+    out["luffing_angle"] = []
     for tk, y in zip(t, ys):
         z, zd = y[:n], y[n:]
         zdd, lam = m.accelerations_and_multipliers(tk, z, zd)
@@ -530,6 +571,11 @@ def _telescopic_result(ts: TelescopicSystem, t, ys, stats, error, scene=None):
         if ts.ropes:
             out.setdefault("rope_tensions", []).append(
                 [r.tension(float(np.real(r.length(Q)[0]))) for unit in ts.ropes for r in unit])
+        # the luffing angle: elevation of boom 1's axis e_s at its root section, rad
+        es = np.real(cardan_frame(*lefts[0](Q)[2]) @ basis.T)[2]
+        out["luffing_angle"].append(math.atan2(es[2], math.hypot(es[0], es[1])))
+        if ts.hoist is not None:
+            _payload_outputs(ts, tk, Q, r, out)
         out["inner_contact_s"].append(Q[ts.s2_index])
         out["outer_contact_s"].append(Q[ts.s3_index[1:]])
         out["constraint_violation"].append(np.max(np.abs(m.constraint_violation(tk, z, zd))))

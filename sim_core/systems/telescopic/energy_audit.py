@@ -36,6 +36,7 @@ import numpy as np
 
 from sim_core.integrate.checks import ENERGY_FAIL, ENERGY_SUSPECT, verdict
 from sim_core.physics.constraints import constraint_terms
+from sim_core.physics.hoist import HangingMass, HoistRope
 from sim_core.physics.point_effects import RopeDrive, SliderSeat
 from sim_core.result import Result
 
@@ -63,7 +64,7 @@ def mechanical_energy(ts, t: float, z: np.ndarray, zd: np.ndarray) -> float:
     g = np.array([0.0, 0.0, -p.gravity])
     en = m.energies(t, Q, Qd, g)
     E = en["T"] + en["U"] + en["V"]
-    if p.payload > 0:
+    if p.payload > 0 and ts.hoist is None:
         r, J, _, _ = ts.tip(Q)
         v = J @ Qd
         E += 0.5 * p.payload * float(v @ v) - p.payload * float(r @ g)
@@ -72,7 +73,24 @@ def mechanical_energy(ts, t: float, z: np.ndarray, zd: np.ndarray) -> float:
             E += rope_energy(pe, float(np.real(pe.length(Q)[0])))
         elif isinstance(pe, SliderSeat):
             E += pe.energy(Q)
+        elif isinstance(pe, HangingMass):          # the swinging payload and its hook
+            E += pe.energy(Q, Qd)
+        elif isinstance(pe, HoistRope):
+            E += pe.energy(Q, t)
     return float(np.real(E))
+
+
+def actuator_power(ts, t: float, Q, lam_luffing: float = 0.0) -> float:
+    """The power (W) of the actuators other than the telescopic stages: the luffing cylinder's
+    lambda b'(t) where it follows a profile (b = its length), and the hoist's dU/dL0 L0_dot
+    (physics.hoist.HoistRope.hoist_power)."""
+    P = 0.0
+    if ts.params.luffing_profile is not None:
+        c = next(c for c in ts.model.nonlinear if c.name == "luffing_cylinder")
+        P += lam_luffing * float(np.atleast_1d(c.target(t)[1])[0])
+    if ts.hoist is not None:
+        P += ts.hoist.hoist_power(Q, t)
+    return P
 
 
 def _filter_power(m, filt, t, Q, Qd, Qdd) -> float:
@@ -115,6 +133,8 @@ class AuditedSystem:
         if "drive_work" in self.terms:
             P["drive_work"] = float(sum(np.sum(lam[row] * np.atleast_1d(c.target(t)[1]))
                                         for c, row in self.drives))
+            P["drive_work"] += actuator_power(self.ts, t, Q,
+                                              lam[self.ts.rows["luffing_cylinder"]][0])
         if "friction_work" in self.terms:
             P["friction_work"] = (float(Qd @ sum(mf.forces(t, Q, Qd, lam)
                                                  for mf in m.multiplier_forces))
@@ -193,6 +213,10 @@ def telescopic_energy_check(ts, res: Result) -> dict:
     P = _drive_power_of_outputs(ts, audit, res)
     if P is None:
         P = np.array([audit.powers(t, y[:n], y[n:2 * n])[1][0] for t, y in zip(ts_, Y)])
+    elif ts.params.luffing_profile is not None or ts.hoist is not None:
+        lam_l = np.asarray(res["luffing_cylinder_force"], dtype=float)
+        P = P + np.array([actuator_power(ts, t, ts.model.full_state(t, y[:n], y[n:2 * n])[0], lam)
+                          for t, y, lam in zip(ts_, Y, lam_l)])
     W = np.concatenate([[0.0], np.cumsum(0.5 * (P[1:] + P[:-1]) * np.diff(ts_))])
     quad = 0.0
     if len(ts_) >= 3:
@@ -206,5 +230,5 @@ def telescopic_energy_check(ts, res: Result) -> dict:
     q = quad / scale
     return {"energy_balance": verdict(
         value, ENERGY_SUSPECT + q, ENERGY_FAIL + q,
-        f"energy growth / exchanged energy (E = T + U + V + payload + ropes, W: drive; E_x = "
+        f"energy growth / exchanged energy (E = T + U + V + payload + ropes, W: drives; E_x = "
         f"{scale:.3g} J, quadrature {q:.2g})")}

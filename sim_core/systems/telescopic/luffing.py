@@ -65,3 +65,32 @@ def luffing_geometry(theta: float, r1: Sequence[float] = R1_DEFAULT,
     L_cyl = float(np.linalg.norm(cyl))
     lever = float(np.linalg.norm(np.cross(r1a - r2a, cyl / L_cyl)))
     return LuffingGeometry(theta, R, origin, r1a, r2a, d3, L_cyl, lever, R[:, 0].copy())
+
+
+def cylinder_length(theta: float, r1, r2, rbar1, rbar3) -> tuple[float, float, float]:
+    """(L, dL/dtheta, d2L/dtheta2) of the luffing cylinder of the rigid crane at the luffing
+    angle theta (rad), m and m/rad: L = |u|, u = r1 - r2 + R(theta)(rbar3 - rbar1) (the
+    geometry of :func:`luffing_geometry`), L' = u.u'/L, L'' = (u'.u' + u.u'')/L - (u.u')^2/L^3
+    with u' = R'(theta) b, u'' = R''(theta) b = -(R(theta) - diag(0, 1, 0)) b."""
+    ct, st = math.cos(theta), math.sin(theta)
+    b = np.asarray(rbar3, float) - np.asarray(rbar1, float)
+    R = np.array([[ct, 0.0, -st], [0.0, 1.0, 0.0], [st, 0.0, ct]])
+    R1 = np.array([[-st, 0.0, -ct], [0.0, 0.0, 0.0], [ct, 0.0, -st]])
+    R2 = np.array([[-ct, 0.0, st], [0.0, 0.0, 0.0], [-st, 0.0, -ct]])
+    u = np.asarray(r1, float) - np.asarray(r2, float) + R @ b
+    u1, u2 = R1 @ b, R2 @ b
+    L = float(np.sqrt(u @ u))
+    d1 = float(u @ u1) / L
+    d2 = float(u1 @ u1 + u @ u2) / L - float(u @ u1) ** 2 / L ** 3
+    return L, d1, d2
+
+
+def cylinder_drive(profile, points):
+    """t -> (L, L_dot, L_ddot) of the luffing cylinder that moves the rigid crane along the
+    luffing-angle profile theta(t) (rad): L(theta(t)), L' theta_dot, L'' theta_dot^2 +
+    L' theta_ddot (chain rule on :func:`cylinder_length`)."""
+    def length(t):
+        smp = profile.sample(t)
+        L, d1, d2 = cylinder_length(float(smp.s), *points)
+        return L, d1 * smp.v, d2 * smp.v * smp.v + d1 * smp.a
+    return length

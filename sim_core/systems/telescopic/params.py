@@ -169,6 +169,16 @@ class TelescopicParams:
     lengths: tuple | None = None            # m, per boom (None: boom_length for every boom)
     overlaps: tuple | None = None           # OverlapSpec per overlap (None: the [contact] values)
     luffing: LuffingSpec | None = None      # None: the paper's mounting points with L_h
+    # actuator profiles (sim_core.systems.telescopic.actuators, SI: m or rad); None: the cubic
+    # schedule of v_max, t_ramp, t_hold_end (telescopic), a held position (the others)
+    drive_profile: object = None
+    luffing_profile: object = None
+    slew_profile: object = None
+    hoist_profile: object = None
+    payload_swing: bool = False             # the payload on the hoist rope (physics.hoist)
+    hoist_length: float = 10.0              # m, unstretched hoist rope at t = 0
+    hoist_EA: float = 2e8                   # N
+    hook_mass: float = 500.0                # kg
 
     def __post_init__(self):
         if self.mechanism not in MECHANISMS:
@@ -204,7 +214,8 @@ class TelescopicParams:
 
     def summary(self, name: str = "telescopic") -> dict:
         """What a Result records as its scene where it was run from parameters, not a scene."""
-        skip = ("sections", "booms", "overlaps", "luffing")
+        skip = ("sections", "booms", "overlaps", "luffing", "drive_profile", "luffing_profile",
+                "slew_profile", "hoist_profile")
         return {"kind": "telescopic", "name": name,
                 "params": {k: v for k, v in self.__dict__.items() if k not in skip}}
 

@@ -93,6 +93,8 @@ from __future__ import annotations
 import math
 from typing import Any
 
+import numpy as np
+
 from sim_core.errors import SceneError
 from sim_core.scene.fields import (
     ERROR_CONTROLLED,
@@ -105,6 +107,7 @@ from sim_core.scene.fields import (
     tables_of,
     vector,
 )
+from sim_core.systems.telescopic import actuators
 from sim_core.systems.telescopic.params import (
     MAX_BOOMS,
     MECHANISMS,
@@ -115,8 +118,11 @@ from sim_core.systems.telescopic.params import (
 )
 
 _TOP = {"kind", "name", "description", "solver", "booms", "drive", "payload", "ropes", "effects",
-        "filtering", "gravity", "contact", "notes", "model", "boom", "overlap", "luffing"}
+        "filtering", "gravity", "contact", "notes", "model", "boom", "overlap", "luffing",
+        "luffing_drive", "slew_drive", "hoist_drive", "hoist"}
 _GIVEN = ("A", "I_t", "I_b", "J", "mass_per_length", "y_c", "z_c")   # constants a table may give
+_PROFILE_KEYS = ("profile", "travel", "a_max", "j_max", "t_start", "table", "table_file",
+                 "max_rate", "max_accel")
 
 
 def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
@@ -159,23 +165,48 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
         sc["luffing"] = _check_luffing(lf, b, sc["booms"]["L_h"], L1)
         sc["booms"]["L_h"] = sc["luffing"]["head_on_boom"][0]
     d = raw.get("drive", {})
-    check_keys(d, {"direction", "v_max", "t_ramp", "t_hold_end", "mechanism"}, "drive")
+    check_keys(d, {"direction", "v_max", "t_ramp", "t_hold_end", "mechanism", *_PROFILE_KEYS},
+               "drive")
     t_ramp = number(d, "t_ramp", "drive", 4.0, lo=0.0, lo_open=True)
     sc["drive"] = {"direction": choice(d, "direction", "drive", ("extraction", "retraction"), "extraction"),
                    "v_max": number(d, "v_max", "drive", 0.5, lo=0.0, lo_open=True),
                    "t_ramp": t_ramp,
                    "t_hold_end": number(d, "t_hold_end", "drive", 12.0, lo=t_ramp),
                    "mechanism": choice(d, "mechanism", "drive", MECHANISMS, "synchronized")}
-    travel = sc["drive"]["v_max"] * sc["drive"]["t_hold_end"]
-    sign = 1 if sc["drive"]["direction"] == "extraction" else -1
-    end = sc["booms"]["stroke0"] + sign * travel
+    sc["drive"].update(_check_actuator(d, "drive", "cubic"))
     L = Lmin
     what = "booms.length" if not boom_tables else "the shortest [[boom]] length"
-    if not 0.0 < end < L:
-        raise SceneError(f"drive: the stroke history moves L_s from {sc['booms']['stroke0']:g} m to "
-                         f"{end:g} m, outside the allowed (0, {L:g}) m ({what}): a boom would "
-                         f"leave its neighbour; reduce drive.v_max or drive.t_hold_end "
-                         f"(v_max * t_hold_end <= {(L - sc['booms']['stroke0']) if sign > 0 else sc['booms']['stroke0']:g} m)")
+    if sc["drive"]["profile"] == "cubic":
+        travel = sc["drive"]["v_max"] * sc["drive"]["t_hold_end"]
+        sign = 1 if sc["drive"]["direction"] == "extraction" else -1
+        end = sc["booms"]["stroke0"] + sign * travel
+        if not 0.0 < end < L:
+            raise SceneError(f"drive: the stroke history moves L_s from {sc['booms']['stroke0']:g} m to "
+                             f"{end:g} m, outside the allowed (0, {L:g}) m ({what}): a boom would "
+                             f"leave its neighbour; reduce drive.v_max or drive.t_hold_end "
+                             f"(v_max * t_hold_end <= {(L - sc['booms']['stroke0']) if sign > 0 else sc['booms']['stroke0']:g} m)")
+        ls_lo, ls_hi = sorted((sc["booms"]["stroke0"], end))
+    else:
+        if sc["drive"]["profile"] == "table":
+            t_tab, s_tab = actuators.table_rows(sc["drive"], source)
+            if "stroke0" in b and b["stroke0"] != s_tab[0]:
+                raise SceneError(f"booms.stroke0 = {b['stroke0']:g} m and the drive table starts "
+                                 f"at L_s = {s_tab[0]:g} m (allowed: equal, or leave stroke0 "
+                                 "out: the table's first row sets it)")
+            sc["booms"]["stroke0"] = float(s_tab[0])
+        if sc["drive"]["mechanism"] != "synchronized":
+            raise SceneError(f"drive.profile = {sc['drive']['profile']!r} with drive.mechanism = "
+                             f"{sc['drive']['mechanism']!r}: the sequential drive runs the cubic "
+                             "schedule stage by stage (allowed: profile 'cubic', or mechanism "
+                             "'synchronized')")
+        prof = actuators.build_profile(sc["drive"], sc["booms"]["stroke0"], "drive", source)
+        ls_lo, ls_hi = actuators.extremes(prof, max(sc["solver"]["t_end"], prof.t_end))
+        if not 0.0 < ls_lo <= ls_hi < L:
+            raise SceneError(f"drive: the {sc['drive']['profile']} profile moves L_s between "
+                             f"{ls_lo:g} and {ls_hi:g} m, outside the allowed (0, {L:g}) m "
+                             f"({what}): a boom would leave its neighbour")
+        actuators.check_limits("drive", sc["drive"], prof, sc["solver"]["t_end"])
+        end = ls_hi if ls_hi != sc["booms"]["stroke0"] else ls_lo
     pl = raw.get("payload", {})
     check_keys(pl, {"mass"}, "payload")
     sc["payload"] = {"mass": number(pl, "mass", "payload", 25000.0, lo=0.0)}
@@ -184,7 +215,8 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
     sc["ropes"] = {"EA": number(r, "EA", "ropes", 1e8, lo=0.0, lo_open=True)}
     e = raw.get("effects", {})
     check_keys(e, {"gravity", "filtering", "friction", "contact_distribution", "torsion",
-                   "rope_elasticity", "flexible", "mass_centre_offset"}, "effects")
+                   "rope_elasticity", "flexible", "mass_centre_offset", "payload_swing"},
+               "effects")
     three = sc["booms"]["count"] == 3 or bool(boom_tables)
     sc["effects"] = {"flexible": boolean(e, "flexible", "effects", True),
                      "torsion": boolean(e, "torsion", "effects", True),
@@ -193,7 +225,8 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
                      "friction": boolean(e, "friction", "effects", False),
                      "contact_distribution": boolean(e, "contact_distribution", "effects", three),
                      "rope_elasticity": boolean(e, "rope_elasticity", "effects", True),
-                     "mass_centre_offset": boolean(e, "mass_centre_offset", "effects", False)}
+                     "mass_centre_offset": boolean(e, "mass_centre_offset", "effects", False),
+                     "payload_swing": boolean(e, "payload_swing", "effects", False)}
     eff = sc["effects"]
     if boom_tables and not (eff["flexible"]
                             and raw.get("model", {}).get("reduction", "none") == "none"):
@@ -245,8 +278,8 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
                          "false: the rigid limit has no contact sections (allowed: 'rigid')")
     # the two sliders of a pair (boom k+1's left-end slider inside boom k, boom k's right-end
     # slider on boom k+1) must fit in the overlap L - L_s(t) at its shortest
-    ls_max = max(sc["booms"]["stroke0"], end)
-    ls_min = min(sc["booms"]["stroke0"], end)
+    ls_max = max(sc["booms"]["stroke0"], end, ls_hi)
+    ls_min = min(sc["booms"]["stroke0"], end, ls_lo)
     ov = tables_of(raw, "overlap")
     if ov or boom_tables:
         sc["overlap"] = _check_overlaps(ov, sc, ls_min, ls_max)
@@ -262,6 +295,53 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
     g = raw.get("gravity", {})
     check_keys(g, {"g"}, "gravity")
     sc["gravity"] = {"g": number(g, "g", "gravity", 9.81, lo=0.0, lo_open=True)}
+    # the other actuators (sim_core.systems.telescopic.actuators) and the hoisted payload
+    t_end = sc["solver"]["t_end"]
+    theta0 = sc["booms"]["luffing_angle_deg"]
+    for table in ("luffing_drive", "slew_drive", "hoist_drive"):
+        tb = table_of(raw, table, "")
+        check_keys(tb, {*_PROFILE_KEYS, "v_max", "t_ramp", "t_hold_end"}, table)
+        if tb:
+            sc[table] = _check_actuator(tb, table, "hold")
+    h = table_of(raw, "hoist", "")
+    check_keys(h, {"length", "EA", "hook_mass"}, "hoist")
+    if eff["payload_swing"] or h:
+        sc["hoist"] = {"length": number(h, "length", "hoist", 10.0, lo=0.0, lo_open=True),
+                       "EA": number(h, "EA", "hoist", 2e8, lo=0.0, lo_open=True),
+                       "hook_mass": number(h, "hook_mass", "hoist", 500.0, lo=0.0)}
+    if ("hoist_drive" in sc or "hoist" in sc) and not eff["payload_swing"]:
+        raise SceneError("[hoist] or [hoist_drive] with effects.payload_swing = false: the hoist "
+                         "rope exists only with the swinging payload (allowed: "
+                         "effects.payload_swing = true, or leave the tables out)")
+    if eff["payload_swing"] and sc["payload"]["mass"] + sc["hoist"]["hook_mass"] <= 0.0:
+        raise SceneError("effects.payload_swing = true with payload.mass = 0 and hoist.hook_mass "
+                         "= 0: nothing hangs on the hoist rope (allowed: a positive mass)")
+    profiles = {}
+    for table, s0 in (("luffing_drive", math.radians(theta0)), ("slew_drive", 0.0),
+                      ("hoist_drive", sc.get("hoist", {}).get("length", 0.0))):
+        if table in sc:
+            prof = actuators.build_profile({**sc[table], "_table": table}, s0, table, source)
+            actuators.check_limits(table, sc[table], prof, t_end)
+            profiles[table] = prof
+    if "luffing_drive" in profiles:
+        lo, hi = (math.degrees(x) for x in actuators.extremes(profiles["luffing_drive"], t_end))
+        if lo < 0.0 or hi > 85.0:
+            raise SceneError(f"luffing_drive: the luffing angle moves between {lo:.4g} and "
+                             f"{hi:.4g} deg, outside the allowed [0, 85] deg")
+        _check_luffing_history(sc, profiles["luffing_drive"], t_end)
+    if "slew_drive" in profiles:
+        _check_slew_history(sc, profiles.get("luffing_drive"), profiles["slew_drive"], t_end)
+    if "hoist_drive" in profiles:
+        lo, _ = actuators.extremes(profiles["hoist_drive"], t_end)
+        if lo < 0.1:
+            raise SceneError(f"hoist_drive: the hoist rope's length drops to {lo:.4g} m (allowed: "
+                             "at least 0.1 m)")
+    if any(k in sc for k in ("luffing_drive", "slew_drive")) or eff["payload_swing"]:
+        if not eff["flexible"] or raw.get("model", {}).get("reduction", "none") != "none":
+            raise SceneError("luffing, slewing or a swinging payload with effects.flexible = "
+                             "false or model.reduction = 'modal': the rigid limit and the modal "
+                             "tables have a fixed luffing angle and a fixed payload (allowed: "
+                             "flexible booms with model.reduction = 'none')")
     mo = raw.get("model", {})
     check_keys(mo, {"reduction", "n_modes"}, "model")
     sc["model"] = {"reduction": choice(mo, "reduction", "model", ("none", "modal"), "none"),
@@ -285,6 +365,91 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
         raise SceneError("model.reduction = 'modal' with effects.friction = true: the modal tables "
                          "are frictionless; set effects.friction = false")
     return sc
+
+
+def _check_actuator(d: dict, table: str, default: str) -> dict:
+    """The drive profile of an actuator table (sim_core.systems.telescopic.actuators): its kind
+    and the kind's keys, positions in the table's unit (m or deg), rates per s.  The telescopic
+    [drive] keeps its cubic keys (direction, v_max, t_ramp, t_hold_end) beside these."""
+    kinds = ("cubic", "trapezoid", "table") if table == "drive" else \
+        ("hold", "cubic", "trapezoid", "table")
+    out = {"profile": choice(d, "profile", table, kinds, default)}
+    kind = out["profile"]
+    lo_travel = 0.0 if table == "drive" else None        # [drive]: a length, with direction
+    if kind in ("cubic", "trapezoid") and "t_start" in d:
+        out["t_start"] = number(d, "t_start", table, lo=0.0)
+    if kind == "cubic" and table != "drive":
+        out["travel"] = number(d, "travel", table)
+        out["t_ramp"] = number(d, "t_ramp", table, 4.0, lo=0.0, lo_open=True)
+        out["t_hold_end"] = number(d, "t_hold_end", table, lo=out["t_ramp"])
+    if kind == "trapezoid":
+        out["travel"] = number(d, "travel", table, lo=lo_travel, lo_open=True)
+        if table != "drive":
+            out["v_max"] = number(d, "v_max", table, lo=0.0, lo_open=True)
+        out["a_max"] = number(d, "a_max", table, lo=0.0, lo_open=True)
+        if "j_max" in d:
+            out["j_max"] = number(d, "j_max", table, lo=0.0, lo_open=True)
+    if kind in ("cubic", "trapezoid") and out.get("travel", 1.0) == 0.0:
+        raise SceneError(f"{table}.travel = 0: allowed a nonzero travel (or profile = 'hold')")
+    if kind == "table":
+        if ("table" in d) == ("table_file" in d):
+            raise SceneError(f"{table}: a table profile needs one of {table}.table (rows of "
+                             f"[time s, position]) or {table}.table_file (a CSV file)")
+        if "table" in d:
+            rows = d["table"]
+            if not (isinstance(rows, list) and all(isinstance(r, list) and len(r) == 2
+                                                   for r in rows)):
+                raise SceneError(f"{table}.table = {rows!r}: must be rows [time s, position]")
+            out["table"] = [[float(x) for x in r] for r in rows]
+        else:
+            if not isinstance(d["table_file"], str):
+                raise SceneError(f"{table}.table_file = {d['table_file']!r}: must be a path")
+            out["table_file"] = d["table_file"]
+    for k in ("max_rate", "max_accel"):
+        if k in d:
+            out[k] = number(d, k, table, lo=0.0, lo_open=True)
+    own = set(_PROFILE_KEYS) | ({"v_max", "t_ramp", "t_hold_end"} if table != "drive" else set())
+    unused = sorted(set(d) & own - set(out) - {"profile"})
+    if unused:
+        raise SceneError(f"{table}.{unused[0]}: not a key of the {kind!r} profile")
+    return out
+
+
+def _luffing_spec(sc: dict) -> LuffingSpec:
+    if sc.get("luffing"):
+        return LuffingSpec(**{k: tuple(v) for k, v in sc["luffing"].items()})
+    return LuffingSpec(head_on_boom=(sc["booms"]["L_h"], -0.556))
+
+
+def _check_luffing_history(sc: dict, prof, t_end: float) -> None:
+    """The luffing cylinder holds the crane at every angle of the profile: a lever of at least
+    0.01 m about the pivot D1 (checked at 2001 times)."""
+    from sim_core.systems.telescopic.luffing import luffing_geometry
+    spec = _luffing_spec(sc)
+    for t in np.linspace(0.0, t_end, 2001):
+        th = float(prof.sample(t).s)
+        geo = luffing_geometry(th, *spec.points())
+        if geo.lever < 0.01:
+            raise SceneError(f"luffing_drive: at t = {t:.4g} s ({math.degrees(th):.4g} deg) the "
+                             f"luffing cylinder's lever about D1 is {geo.lever:.3g} m (allowed: "
+                             "at least 0.01 m; change the profile or the [luffing] points)")
+
+
+def _check_slew_history(sc: dict, luff, slew, t_end: float) -> None:
+    """The boom's axis stays more than 15 deg away from the lateral axis g1 of its Cardan
+    reference basis (the horizontal normal of the initial luffing plane, Section 5: the
+    parametrisation is singular where e_s = g1), checked at 2001 times."""
+    th0 = math.radians(sc["booms"]["luffing_angle_deg"])
+    for t in np.linspace(0.0, t_end, 2001):
+        th = th0 if luff is None else float(luff.sample(t).s)
+        ph = float(slew.sample(t).s)
+        c = abs(math.cos(th) * math.sin(ph))           # |e_s . Y|
+        if c > math.cos(math.radians(15.0)):
+            raise SceneError(f"slew_drive: at t = {t:.4g} s the boom (luffing {math.degrees(th):.4g}"
+                             f" deg, slewed {math.degrees(ph):.4g} deg) points within "
+                             f"{math.degrees(math.acos(min(c, 1.0))):.3g} deg of the initial "
+                             "lateral axis, where the booms' Cardan angles are singular (allowed: "
+                             "more than 15 deg; slew less or luff higher)")
 
 
 def _check_booms(tables: list, E0: float, rho0: float) -> list[dict]:
@@ -512,7 +677,20 @@ def params_from_scene(sc: dict):
     luffing = None
     if sc.get("luffing"):
         luffing = LuffingSpec(**{k: tuple(v) for k, v in sc["luffing"].items()})
+    src = sc.get("source")
+    profiles = {"drive_profile": None if d.get("profile", "cubic") == "cubic" else
+                actuators.build_profile(d, b["stroke0"], "drive", src)}
+    for table, key, s0 in (("luffing_drive", "luffing_profile",
+                            math.radians(b["luffing_angle_deg"])),
+                           ("slew_drive", "slew_profile", 0.0),
+                           ("hoist_drive", "hoist_profile", sc.get("hoist", {}).get("length"))):
+        profiles[key] = (actuators.build_profile({**sc[table], "_table": table}, s0, table, src)
+                         if sc.get(table) else None)
+    hoist = sc.get("hoist", {})
     return TelescopicParams(
+        **profiles, payload_swing=sc["effects"].get("payload_swing", False),
+        hoist_length=hoist.get("length", 10.0), hoist_EA=hoist.get("EA", 2e8),
+        hook_mass=hoist.get("hook_mass", 500.0),
         booms=booms, overlaps=overlaps, luffing=luffing,
         n_booms=b["count"], boom_length=b.get("length", booms[0].length if booms else 10.0),
         luffing_angle_deg=b["luffing_angle_deg"],
