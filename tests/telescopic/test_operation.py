@@ -231,3 +231,124 @@ def test_slack_hoist_rope_is_not_a_crash():
     assert res.error is None and not res.suspect
     assert np.min(res["hoist_rope_force"]) == 0.0             # slack at some output time
     assert res["hoist_rope_force"][0] > 0.0
+
+
+# -- the energy audit with every actuator moving ---------------------------------------------
+
+@pytest.fixture(scope="module")
+def moving_audit():
+    """The paper's scene (friction on, 2 sub-elements per spline element) with the telescopic
+    cylinder, the luffing cylinder (+2 deg), the slewing drive (+3 deg) and the hoist (10 ->
+    9.9 m) all moving in the same 0.15 s window, the payload swinging on its rope; the works
+    integrated as extra states (energy_audit.run_energy_audit) at rtol 1e-6."""
+    from sim_core.systems.telescopic.energy_audit import run_energy_audit
+    sc = load_scene("telescopic_extraction", overrides={
+        "booms.n_nodes": 3, "drive.t_ramp": 0.5, "drive.t_hold_end": 0.6,
+        "luffing_drive.profile": "cubic", "luffing_drive.travel": 2.0,
+        "luffing_drive.t_ramp": 0.1, "luffing_drive.t_hold_end": 0.2,
+        "slew_drive.profile": "cubic", "slew_drive.travel": 3.0,
+        "slew_drive.t_ramp": 0.1, "slew_drive.t_hold_end": 0.2,
+        "effects.payload_swing": True, "hoist_drive.profile": "table",
+        "hoist_drive.table": [[0.0, 10.0], [0.2, 9.9]]})
+    ts = build_telescopic(params_from_scene(sc))
+    z, _ = initial_equilibrium(ts)
+    return run_energy_audit(ts, np.concatenate([z, 0 * z]), 0.15, rtol=1e-6, atol=1e-7,
+                            n_output=16)
+
+
+def test_energy_audit_closes_with_luffing_slewing_and_swing(moving_audit):
+    """E = booms' T + U + V + the swinging payload's kinetic and gravity energy + the ropes'
+    strain energy changes by the work of the constraints on the booms (telescopic and luffing
+    cylinders: lambda b'(t); the turntable: -lambda . g_phi phi_dot) and of the hoist
+    (dU/dL0 L0_dot), less friction and filter dissipation, to the solver tolerance (rtol times
+    the energy exchanged); and that constraint work is the actuators' work (drive_work: every
+    actuator's own power), to the same tolerance."""
+    a = moving_audit
+    scale = (np.max(np.abs(a["energy"] - a["energy"][0])) + np.max(np.abs(a["drive_work"]))
+             + np.max(np.abs(a["friction_work"])) + np.max(np.abs(a["filter_work"])))
+    tol = 1e-6 * scale
+    assert np.max(np.abs(a["residual"])) <= tol
+    assert np.max(np.abs(a["constraint_work"] - a["drive_work"])) <= tol
+    # the check can fail: the actuators' work is far above the tolerance
+    assert np.max(np.abs(a["residual"] + a["drive_work"])) > 100 * tol
+
+
+# -- slewing ---------------------------------------------------------------------------------
+
+def test_constant_slewing_sway_and_radial_reaction():
+    """The nearly rigid crane (E = 2.1e12 Pa, 60 deg, stages held) slews up to omega = 0.1 rad/s
+    (an S-curve ramp of 6 s) with the payload and hook (25.5 t) on a 2 m rope, then at constant
+    rate.  Seen from the turntable the payload is a conical pendulum: its steady sway outwards
+    from the vertical is tan(beta) = omega^2 R_p / g (centrifugal force m omega^2 R_p against
+    the weight, R_p the payload's distance from the slew axis); and the turntable holds the
+    crane against the centrifugal forces of the booms and the payload, a horizontal inward
+    force sum m_i omega^2 r_i (the booms' mass centres on their axes at the rigid geometry,
+    the payload at R_p).  The ramp leaves a pendulum oscillation that the Coriolis force splits
+    into the frequencies Omega_0 -+ omega (Omega_0 = sqrt(g / l)); the steady values are the
+    offsets of a least-squares fit of the offset plus those two sinusoids (frequencies free)
+    over 1.2 pendulum periods.  The turntable's vertical force balances the weight (a check of
+    the force's reading, 1e-4: the payload's bounce is not averaged out).  Tolerance 1 % each
+    (measured ~2e-4: the booms' deflection)."""
+    from scipy.optimize import curve_fit
+
+    from sim_core.systems.telescopic.luffing import luffing_geometry
+    from sim_core.systems.telescopic.params import boom_section
+    w, ramp, L0, g = 0.1, 6.0, 2.0, 9.81
+    sc = load_scene("telescopic_extraction", overrides={
+        **HOLD, "booms.n_nodes": 3, "booms.E": 2.1e12, "effects.friction": False,
+        "effects.contact_distribution": False, "effects.payload_swing": True,
+        "hoist.length": L0, "slew_drive.profile": "trapezoid", "slew_drive.travel": 200.0,
+        "slew_drive.v_max": math.degrees(w), "slew_drive.a_max": math.degrees(w) / (0.75 * ramp),
+        "slew_drive.j_max": math.degrees(w) / (0.75 * ramp) / (0.25 * ramp)})
+    p = params_from_scene(sc)
+    ts = build_telescopic(p)
+    m = ts.model
+    z, _ = initial_equilibrium(ts)
+    m_hang = p.payload + p.hook_mass
+    period = 2 * math.pi * math.sqrt(L0 * (1 + m_hang * g / p.hoist_EA) / g)
+    t_end = ramp + 1.2 * period
+    t, ys, _ = integrate(m, np.concatenate([z, 0 * z]), t_end,
+                         {"rtol": 1e-7, "atol": 1e-9, "n_output": 300, "method": "auto"})
+    n = m.n_dof
+    ip = int(ts.hoist.bottom.coords(None)[0])
+    cyl = next(c for c in m.nonlinear if c.name == "luffing_cylinder")
+    tt, sway, R_p, F_in, F_z = [], [], [], [], []
+    for tk, y in zip(t, ys):
+        if tk < ramp:
+            continue
+        Q, _ = m.full_state(tk, y[:n], y[n:])
+        _, lam = m.accelerations_and_multipliers(tk, y[:n], y[n:])
+        phi = float(np.real(Q[ts.i_phi]))
+        u = np.array([math.cos(phi), math.sin(phi), 0.0])
+        d = np.real(Q[ip:ip + 3] - ts.tip(Q)[0])
+        r3, r2 = (np.real(pt(Q)[0]) for pt in cyl.points)
+        # the turntable's force on the crane: the pivot rows and the cylinder's force at D3
+        F = lam[ts.rows["pivot"]] + lam[ts.rows["luffing_cylinder"]][0] * (r3 - r2) / \
+            np.linalg.norm(r3 - r2)
+        tt.append(tk)
+        sway.append(math.atan2(d @ u, -d[2]))
+        R_p.append(float(np.real(Q[ip:ip + 2]) @ u[:2]))
+        F_in.append(-float(np.real(F) @ u))
+        F_z.append(float(np.real(F[2])))
+    tt = np.array(tt)
+    geo = luffing_geometry(math.radians(60.0), *p.luffing.points())
+    masses = [p.lengths[k] * boom_section(k, p).rhoA for k in range(3)]
+    mr = sum(mk * (geo.origin + (k * p.stroke0 + 0.5 * p.lengths[k]) * geo.e_s)[0]
+             for k, mk in enumerate(masses))
+    Rp = float(np.mean(R_p))
+    O0 = 2 * math.pi / period
+
+    def two_modes(t, c, a1, b1, a2, b2, o1, o2):
+        return (c + a1 * np.cos(o1 * t) + b1 * np.sin(o1 * t) + a2 * np.cos(o2 * t)
+                + b2 * np.sin(o2 * t))
+
+    def steady(y):
+        y = np.asarray(y)
+        popt, _ = curve_fit(two_modes, tt, y, p0=[y.mean(), 0, 0, 0, 0, O0 - w, O0 + w],
+                            maxfev=20000)
+        return popt[0]
+
+    assert steady(sway) == pytest.approx(math.atan(w * w * Rp / g), rel=1e-2)
+    assert steady(F_in) == pytest.approx((mr + m_hang * Rp) * w * w, rel=1e-2)
+    # vertical: the weight, up to the payload's vertical oscillation (second order in the sway)
+    assert np.mean(F_z) == pytest.approx((sum(masses) + m_hang) * g, rel=1e-4)

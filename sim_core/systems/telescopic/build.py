@@ -37,7 +37,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from sim_core.model.boundary import boundary_condition, fix_material_coordinate, no_torsion, reference_basis
+from sim_core.model.boundary import (
+    LinearConstraint,
+    boundary_condition,
+    fix_material_coordinate,
+    no_torsion,
+    reference_basis,
+)
 from sim_core.model.model import Model
 from sim_core.physics.beam.moving_node_beam import Beam
 from sim_core.physics.constraints import (
@@ -53,6 +59,7 @@ from sim_core.physics.drive_profiles import CubicSmoothstepSchedule, HoldProfile
 from sim_core.physics.hoist import HangingMass, HoistRope, free_point
 from sim_core.physics.effects import Effect, Elasticity, Gravity, Inertia, StressFilter
 from sim_core.physics.point_effects import PointMass, RopeDrive, SliderSeat
+from sim_core.physics.rigid_body import beam_frame, revolute_axis, turntable_frame
 from sim_core.systems.telescopic.luffing import cylinder_drive, luffing_geometry
 from sim_core.systems.telescopic.params import TelescopicParams, boom_section
 from sim_core.systems.telescopic.sliders import slider_geometries
@@ -78,6 +85,7 @@ class TelescopicSystem:
     stages: list = field(default_factory=list)  # schedule of each stage k (boom k -> k+1)
     hoist: object = None                        # physics.hoist.HoistRope (payload_swing)
     slew_angle: object = None                   # t -> slew angle (rad) where the crane slews
+    i_phi: int | None = None                    # the turntable's slew-angle coordinate
 
 
 def drive_layout(n_booms: int, mechanism: str) -> tuple[list[int], list[int]]:
@@ -196,8 +204,13 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
     lin.append(fix_material_coordinate(offsets, beams, 0, 1, p.L_h))
     if not p.torsion:
         lin.append(no_torsion(offsets, beams))
-    # extra coordinates: the inner contact points s_2,k, then the swinging payload's position
-    n_extra = N - 1 + (3 if p.payload_swing else 0)
+    # extra coordinates: the inner contact points s_2,k, then the swinging payload's position,
+    # then the turntable's slew angle phi (prescribed: a linear constraint phi = phi(t))
+    n_extra = N - 1 + (3 if p.payload_swing else 0) + (1 if p.slew_profile is not None else 0)
+    i_phi = None
+    if p.slew_profile is not None:
+        i_phi = int(sum(b.n_coords for b in beams)) + n_extra - 1
+        lin.append(_slew_signal(p.slew_profile, i_phi))
     model = Model(beams, effects, [], lin, n_extra=n_extra, baumgarte=p.baumgarte)
 
     # initial straight configuration: boom k's left section a_k = k L_s along boom 1
@@ -232,17 +245,30 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
     # pivot D1: revolute about Y (point fixed, beta = gamma = 0 at boom 1's left section)
     _, _, rbar1, rbar3 = p.luffing.points()
     D1 = mp(0, s_fixed=0.0, offset=rbar1)
-    add(point_coincidence("pivot", D1, fixed=geo.d1))
-    root = mp(0, s_fixed=0.0)
-    add(angles("pivot_axis", root, fixed=[0.0, 0.0, 0.0], keep=(1, 2)))
+    base = fixed_point(geo.d2)
+    if i_phi is None:
+        add(point_coincidence("pivot", D1, fixed=geo.d1))
+        root = mp(0, s_fixed=0.0)
+        add(angles("pivot_axis", root, fixed=[0.0, 0.0, 0.0], keep=(1, 2)))
+    else:
+        # the pivot D1 and the cylinder base D2 ride on the turntable, which turns about the
+        # vertical by phi; the pivot is a revolute joint about the turntable's plane normal
+        # (3 point rows and 2 axis rows, sim_core.physics.rigid_body, as in the folding scene)
+        def turn(point=(0.0, 0.0, 0.0)):
+            return turntable_frame(model.n_coords, i_phi, SLEW_AXIS, PLANE_BASIS, point)
+        add(point_coincidence("pivot", D1, turn((geo.d1[0], geo.d1[2], 0.0))))
+        root_frame, table = beam_frame(model, 0, 0.0), turn()
+        Ra0, Rb0 = table(Q0)[2], root_frame(Q0)[2]
+        add(revolute_axis("pivot_axis", table, root_frame, Ra0.T @ PLANE_BASIS[:, 2],
+                          Rb0.T @ PLANE_BASIS[:, 0], Rb0.T @ PLANE_BASIS[:, 1]))
+        base = turn((geo.d2[0], geo.d2[2], 0.0))
     # luffing cylinder: rigid massless rod D2-D3 held at its initial length (docs/model.md#input-luffing)
     D3 = mp(0, s_fixed=p.L_h, offset=(0.0, 0.0, rbar3[2]))
     Lc = float(geo.cylinder_length)
     if p.luffing_profile is None:
-        add(distance_driver("luffing_cylinder", D3, fixed_point(geo.d2),
-                            lambda t: (Lc, 0.0, 0.0)))
+        add(distance_driver("luffing_cylinder", D3, base, lambda t: (Lc, 0.0, 0.0)))
     else:          # the cylinder length that moves the rigid crane along the luffing profile
-        add(distance_driver("luffing_cylinder", D3, fixed_point(geo.d2),
+        add(distance_driver("luffing_cylinder", D3, base,
                             cylinder_drive(p.luffing_profile, p.luffing.points())))
     # contact constraints I and II between adjacent booms (Section 6).  The moment model decides
     # which Cardan-angle rows stay constraints: all three (rigid, Eqs. 47-48), or the twist only
@@ -336,7 +362,9 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
     model.point_effects = pe + list(seats.values())
     ts = TelescopicSystem(model, Q0, sched, s2_index, s3_index, rows, tip, p,
                           angle_rows=angle_rows, seats=seats, drives=drives, ropes=ropes,
-                          stages=stages, hoist=hoist)
+                          stages=stages, hoist=hoist, i_phi=i_phi,
+                          slew_angle=None if i_phi is None else
+                          (lambda t, prof=p.slew_profile: float(prof.sample(t).s)))
     # Section 8 contact analysis: the slider springs on every overlap's bearing patches
     # (sim_core.systems.telescopic.sliders); with friction off it is only evaluated for the
     # outputs (it does not act on the motion), with contact_distribution off it is not built
@@ -357,6 +385,19 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
     if p.friction:
         model.multiplier_forces = [ts.contact]
     return ts
+
+
+# the turntable: slew axis vertical (global Z); the luffing plane's basis at phi = 0 has the
+# columns e_u = X (forward), e_v = Z (up), n = e_u x e_v = -Y (sim_core.physics.rigid_body)
+SLEW_AXIS = np.array([0.0, 0.0, 1.0])
+PLANE_BASIS = np.column_stack([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
+
+
+def _slew_signal(profile, i_phi: int):
+    """The prescribed slew angle phi(t) (rad) as a linear constraint on its coordinate."""
+    def part(k):
+        return lambda t: np.array([float(profile.sample(t)[k])])
+    return LinearConstraint("slew", [{i_phi: 1.0}], part(0), part(1), part(2))
 
 
 def _payload_outputs(ts: TelescopicSystem, t: float, Q, r_tip, out: dict) -> None:
@@ -574,6 +615,8 @@ def _telescopic_result(ts: TelescopicSystem, t, ys, stats, error, scene=None):
         # the luffing angle: elevation of boom 1's axis e_s at its root section, rad
         es = np.real(cardan_frame(*lefts[0](Q)[2]) @ basis.T)[2]
         out["luffing_angle"].append(math.atan2(es[2], math.hypot(es[0], es[1])))
+        if ts.i_phi is not None:
+            out.setdefault("slew_angle", []).append(float(np.real(Q[ts.i_phi])))
         if ts.hoist is not None:
             _payload_outputs(ts, tk, Q, r, out)
         out["inner_contact_s"].append(Q[ts.s2_index])

@@ -80,6 +80,14 @@ def mechanical_energy(ts, t: float, z: np.ndarray, zd: np.ndarray) -> float:
     return float(np.real(E))
 
 
+def slew_power(ts, t: float, Q, Qd, lam) -> float:
+    """The slewing drive's power (W): the turntable's prescribed rate phi_dot times the torque
+    the constraint rows exert on it, -lambda . g_phi phi_dot (on the manifold the rows' rates
+    vanish, g_Q Q_dot = 0, so this equals their power on the booms' coordinates)."""
+    _, J, _, _ = constraint_terms(ts.model.nonlinear, t, Q, Qd)
+    return -float(np.real(lam @ J[:, ts.i_phi])) * float(np.real(Qd[ts.i_phi]))
+
+
 def actuator_power(ts, t: float, Q, lam_luffing: float = 0.0) -> float:
     """The power (W) of the actuators other than the telescopic stages: the luffing cylinder's
     lambda b'(t) where it follows a profile (b = its length), and the hoist's dU/dL0 L0_dot
@@ -130,11 +138,17 @@ class AuditedSystem:
         if "constraint_work" in self.terms:
             _, J, _, _ = constraint_terms(m.nonlinear, t, Q, Qd)
             P["constraint_work"] = float(lam @ (J @ Qd))
+            if self.ts.i_phi is not None:       # on the booms, not on the turntable's phi
+                P["constraint_work"] -= float(lam @ J[:, self.ts.i_phi]) * float(Qd[self.ts.i_phi])
+            if self.ts.hoist is not None:       # the hoist: a rope of prescribed length
+                P["constraint_work"] += self.ts.hoist.hoist_power(Q, t)
         if "drive_work" in self.terms:
             P["drive_work"] = float(sum(np.sum(lam[row] * np.atleast_1d(c.target(t)[1]))
                                         for c, row in self.drives))
             P["drive_work"] += actuator_power(self.ts, t, Q,
                                               lam[self.ts.rows["luffing_cylinder"]][0])
+            if self.ts.i_phi is not None:
+                P["drive_work"] += slew_power(self.ts, t, Q, Qd, lam)
         if "friction_work" in self.terms:
             P["friction_work"] = (float(Qd @ sum(mf.forces(t, Q, Qd, lam)
                                                  for mf in m.multiplier_forces))
@@ -210,7 +224,7 @@ def telescopic_energy_check(ts, res: Result) -> dict:
     audit = AuditedSystem(ts, ("drive_work",))
     n = audit.n
     E = np.array([mechanical_energy(ts, t, y[:n], y[n:2 * n]) for t, y in zip(ts_, Y)])
-    P = _drive_power_of_outputs(ts, audit, res)
+    P = None if ts.i_phi is not None else _drive_power_of_outputs(ts, audit, res)
     if P is None:
         P = np.array([audit.powers(t, y[:n], y[n:2 * n])[1][0] for t, y in zip(ts_, Y)])
     elif ts.params.luffing_profile is not None or ts.hoist is not None:
