@@ -107,6 +107,53 @@ def constraint_terms(cons: list[NonlinearConstraint], t: float, Q: Vec, Qd: Vec)
             g, G, quad, _ = prog.terms(Q, Qd)
             b, bd, bdd = targets(cons, t)
             return g - b, G, G @ Qd - bd, bdd - quad
+        part = _partition(cons)
+        if part is not None:
+            return _partitioned_terms(part, t, Q, Qd)
+    return _python_terms(cons, t, Q, Qd, real)
+
+
+def _partition(cons):
+    """Where no compiled program covers the whole list (a turntable's joint rows beside the
+    booms' contact rows): (the compiled program of the rows it covers, their row indices, the
+    other constraints, their row indices), cached on the first constraint; None where the
+    compiled part would be empty or everything."""
+    key = tuple(id(c) for c in cons)
+    hit = cons[0].__dict__.get("_partition")
+    if hit is not None and hit[0] == key:
+        return hit[1]
+    kinds = ("material", "fixed")
+    comp = [c for c in cons if c.program is not None
+            and all(getattr(f, "spec", (None,))[0] in kinds for f in c.program[2])]
+    rest = [c for c in cons if all(c is not x for x in comp)]
+    part = None
+    if comp and rest:
+        prog = constraint_compiled.cached_program(comp, "_partial_program",
+                                                  constraint_compiled._build)
+        if prog is not None:
+            starts = np.cumsum([0] + [c.m for c in cons])
+            rows = {id(c): np.arange(starts[k], starts[k + 1]) for k, c in enumerate(cons)}
+            part = (prog, comp, np.concatenate([rows[id(c)] for c in comp]), rest,
+                    np.concatenate([rows[id(c)] for c in rest]), int(starts[-1]))
+    cons[0].__dict__["_partition"] = (key, part)
+    return part
+
+
+def _partitioned_terms(part, t, Q, Qd):
+    """constraint_terms from the compiled rows of a partition and the others in Python, in
+    the list's row order."""
+    prog, comp, r_comp, rest, r_rest, m = part
+    g, G, quad, _ = prog.terms(Q, Qd)
+    b, bd, bdd = targets(comp, t)
+    phi, jac, dphi, rhs = (np.empty(m), np.empty((m, len(Q))), np.empty(m), np.empty(m))
+    phi[r_comp], jac[r_comp], dphi[r_comp], rhs[r_comp] = g - b, G, G @ Qd - bd, bdd - quad
+    phi[r_rest], jac[r_rest], dphi[r_rest], rhs[r_rest] = _python_terms(rest, t, Q, Qd, True)
+    return phi, jac, dphi, rhs
+
+
+def _python_terms(cons, t, Q, Qd, real):
+    """constraint_terms of each constraint's closure: the Jacobian's real part and the
+    quadratic velocity term g_QQ[Q_dot, Q_dot] from one complex-step evaluation."""
     phis, jacs, dphis, rhs = [], [], [], []
     Qc = Q + 1j * COMPLEX_STEP * Qd                  # one complex state: the point caches serve all rows
     for c in cons:

@@ -15,6 +15,7 @@ Jerk excludes the Dirac parts at discontinuities of a (Eq. 52 decay start/end).
 
 from __future__ import annotations
 
+import bisect
 import math
 from dataclasses import dataclass
 from typing import NamedTuple, Protocol, Union
@@ -70,9 +71,17 @@ class _PiecewiseProfile:
         """All four quantities at t (s): s = s0 + sign*s_unit, v/a/j = sign * unit values."""
         scalar = np.ndim(t) == 0
         if scalar and hasattr(self, "_unit_scalar"):
-            s, v, a, j = self._unit_scalar(float(t) - self.t_start)
-            return MotionSample(float(self.s0 + self.sign * s), float(self.sign * v),
-                                float(self.sign * a), float(self.sign * j))
+            # the last scalar sample is kept: a model asks for the same time several times
+            # per right-hand side (the value, rate and acceleration of a signal)
+            t = float(t)
+            last = self.__dict__.get("_last")
+            if last is not None and last[0] == t:
+                return last[1]
+            s, v, a, j = self._unit_scalar(t - self.t_start)
+            smp = MotionSample(float(self.s0 + self.sign * s), float(self.sign * v),
+                               float(self.sign * a), float(self.sign * j))
+            self.__dict__["_last"] = (t, smp)
+            return smp
         tl = np.asarray(t, dtype=float) - self.t_start
         s, v, a, j = self._unit(tl)
         return MotionSample(_out(self.s0 + self.sign * s, scalar), _out(self.sign * v, scalar),
@@ -286,6 +295,19 @@ class _JerkSegments:
         object.__setattr__(self, "_state", np.array(state))
         object.__setattr__(self, "_jerks", np.array(list(jerks) + [0.0]))
 
+    def _segments_scalar(self, tl: float):
+        """_unit of one time (bisect into the knots; the same formulas)."""
+        if tl < 0.0:
+            return 0.0, 0.0, 0.0, 0.0
+        knots = self._knots
+        k = bisect.bisect_right(knots, tl) - 1
+        s0, v0, a0 = self._state[k]
+        if k == len(knots) - 1:
+            return float(s0), 0.0, 0.0, 0.0
+        dt, j = tl - knots[k], self._jerks[k]
+        return (float(s0 + v0 * dt + a0 * dt * dt / 2 + j * dt ** 3 / 6),
+                float(v0 + a0 * dt + j * dt * dt / 2), float(a0 + j * dt), float(j))
+
     def _unit(self, tl):
         tl = np.asarray(tl, dtype=float)
         k = np.clip(np.searchsorted(self._knots, tl, side="right") - 1, 0, len(self._knots) - 1)
@@ -355,6 +377,22 @@ class TrapezoidProfile(_JerkSegments, _PiecewiseProfile):
             self._build(d_acc + [cruise] + d_acc[::-1],
                         j_acc + [0.0] + [-x for x in j_acc])
         object.__setattr__(self, "v_peak", v)
+
+    def _unit_scalar(self, tl: float):
+        if self._trap is None:
+            return self._segments_scalar(tl)
+        ta, tc, v = self._trap
+        a = v / ta
+        if tl < 0.0:
+            return 0.0, 0.0, 0.0, 0.0
+        if tl < ta:
+            return a * tl * tl / 2, a * tl, a, 0.0
+        if tl < ta + tc:
+            return v * ta / 2 + v * (tl - ta), v, 0.0, 0.0
+        if tl < 2 * ta + tc:
+            d = tl - ta - tc
+            return v * ta / 2 + v * tc + v * d - a * d * d / 2, v - a * d, -a, 0.0
+        return v * ta + v * tc, 0.0, 0.0, 0.0
 
     @property
     def t_end(self) -> float:
@@ -450,8 +488,15 @@ class TableProfile(_PiecewiseProfile):
         return s, v, a, j
 
     def _unit_scalar(self, tl):
-        s, v, a, j = self._unit(np.array(tl))
-        return float(s), float(v), float(a), float(j)
+        """_unit of one time: the cubic piece that holds it, evaluated by Horner's rule."""
+        t = self.t_table
+        if tl <= t[0] or tl >= t[-1]:
+            return float(self._spline(min(max(tl, t[0]), t[-1])) - self.s0), 0.0, 0.0, 0.0
+        i = bisect.bisect_right(t, tl) - 1
+        c0, c1, c2, c3 = self._spline.c[:, i]
+        x = tl - t[i]
+        return (float(((c0 * x + c1) * x + c2) * x + c3 - self.s0),
+                float((3 * c0 * x + 2 * c1) * x + c2), float(6 * c0 * x + 2 * c1), float(6 * c0))
 
 
 def read_table_csv(path) -> tuple[np.ndarray, np.ndarray]:

@@ -89,7 +89,9 @@ def plot_telescopic(result: Result, out: str | Path, slider_times=None) -> list[
     t = result.t
     paths = []
     theta = _luffing_angle(result)
-    if theta is not None and "tip_position" in result and "piston_stroke" in result:
+    moving = "slew_angle" in result or bool(result.scene.get("luffing_drive"))
+    if (theta is not None and "tip_position" in result and "piston_stroke" in result
+            and not moving):             # the rigid limit of a fixed luffing angle and no slew
         e = np.array([np.cos(np.radians(theta)), np.sin(np.radians(theta))])
         tip = result["tip_position"][:, [0, 2]]
         vel = result["tip_velocity"][:, [0, 2]]
@@ -171,5 +173,61 @@ def plot_telescopic(result: Result, out: str | Path, slider_times=None) -> list[
         fig.suptitle("normal force of the slider springs")
         fig.tight_layout()
         paths.append(save_figure(fig, out / "slider_contact_forces.png"))
+        plt.close(fig)
+    paths += _operation_figures(result, out, plt)
+    return paths
+
+
+def _operation_figures(result: Result, out: Path, plt) -> list[Path]:
+    """The figures of an operation (luffing, slewing, a swinging payload):
+
+    * ``crane_motion.png``: luffing angle and slew angle (deg), piston stroke (m), luffing and
+      telescopic cylinder forces (kN);
+    * ``payload_sway.png``: sway angles in the luffing plane and across it (deg) and the hoist
+      rope's force (kN);
+    * ``tip_path.png``: the paths of the boom tip and the payload seen from above (X, Y) and
+      from the side (horizontal distance from the slew axis, Z)."""
+    t, paths = result.t, []
+    if "slew_angle" in result or "sway_angle" in result or result.scene.get("luffing_drive"):
+        fig, axes = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
+        axes[0].plot(t, np.degrees(result["luffing_angle"]), label="luffing angle")
+        if "slew_angle" in result:
+            axes[0].plot(t, np.degrees(result["slew_angle"]), label="slew angle")
+        axes[1].plot(t, result["piston_stroke"], label="piston stroke (stage 1-2)")
+        axes[2].plot(t, result["luffing_cylinder_force"] / 1e3, label="luffing cylinder")
+        axes[2].plot(t, result["telescopic_cylinder_force"] / 1e3, label="telescopic cylinder")
+        _label_stack(axes, ("angle [deg]", "stroke [m]", "force [kN]"))
+        fig.suptitle("the crane's motion and its cylinders")
+        fig.tight_layout()
+        paths.append(save_figure(fig, out / "crane_motion.png"))
+        plt.close(fig)
+    if "sway_angle" in result:
+        sway = np.degrees(result["sway_angle"])
+        fig, axes = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
+        axes[0].plot(t, sway[:, 0], label="in the luffing plane (outwards +)")
+        axes[0].plot(t, sway[:, 1], label="across it")
+        axes[1].plot(t, result["hoist_rope_force"] / 1e3, label="hoist rope")
+        _label_stack(axes, ("sway from the vertical [deg]", "rope force [kN]"))
+        fig.suptitle("the payload on the hoist rope")
+        fig.tight_layout()
+        paths.append(save_figure(fig, out / "payload_sway.png"))
+        plt.close(fig)
+        tip, pay = result["tip_position"], result["payload_position"]
+        fig, axes = plt.subplots(1, 2, figsize=(11, 5))
+        for r, lab in ((tip, "boom tip"), (pay, "payload")):
+            axes[0].plot(r[:, 0], r[:, 1], label=lab)
+            axes[1].plot(np.hypot(r[:, 0], r[:, 1]), r[:, 2], label=lab)
+        axes[0].set_aspect("equal", adjustable="datalim")
+        axes[0].set_xlabel("X [m]")
+        axes[0].set_ylabel("Y [m]")
+        axes[0].set_title("from above")
+        axes[1].set_xlabel("distance from the slew axis [m]")
+        axes[1].set_ylabel("Z [m]")
+        axes[1].set_title("from the side")
+        for ax in axes:
+            ax.grid(alpha=0.3)
+            ax.legend(loc="best", fontsize=8)
+        fig.tight_layout()
+        paths.append(save_figure(fig, out / "tip_path.png"))
         plt.close(fig)
     return paths

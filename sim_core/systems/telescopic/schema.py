@@ -678,7 +678,8 @@ def params_from_scene(sc: dict):
     if sc.get("luffing"):
         luffing = LuffingSpec(**{k: tuple(v) for k, v in sc["luffing"].items()})
     src = sc.get("source")
-    profiles = {"drive_profile": None if d.get("profile", "cubic") == "cubic" else
+    legacy = d.get("profile", "cubic") == "cubic" and "t_start" not in d
+    profiles = {"drive_profile": None if legacy else
                 actuators.build_profile(d, b["stroke0"], "drive", src)}
     for table, key, s0 in (("luffing_drive", "luffing_profile",
                             math.radians(b["luffing_angle_deg"])),
