@@ -281,6 +281,21 @@ class Model:
         states)."""
         return element_compiled.AVAILABLE and self._compiled_effects(el.section) is not None
 
+    def effects_changed(self) -> None:
+        """After effects were added to an assembled model (an effect plug-in): recompute what
+        the effects need and drop the compiled kernel's verdicts."""
+        self.needs = frozenset().union(*(e.needs for e in self.effects)) if self.effects \
+            else frozenset()
+        self.__dict__.pop("_compiled_kw", None)
+
+    @property
+    def uncompiled_effects(self) -> list[str]:
+        """Names of the effects the compiled element kernel does not cover (they send the
+        elements to the numpy path)."""
+        from sim_core.physics.effects import Elasticity, Inertia
+        covered = (Inertia, Elasticity, StressFilter, Gravity)
+        return [e.name for e in self.effects if type(e) not in covered]
+
     def _compiled_effects(self, section):
         """element_compiled's effect arguments for this section, or None where the kernel does
         not cover the effects.  The verdict and the constant arguments are kept per section and
@@ -296,6 +311,14 @@ class Model:
                 cache[key] = (kw, grav[0] if grav else None, filt[0] if filt else None)
             except ValueError:
                 cache[key] = None
+                names = self.uncompiled_effects
+                if names and element_compiled.AVAILABLE and not self.__dict__.get("_warned"):
+                    # said once per model, never silently: the run is slower on this path
+                    import warnings
+                    self._warned = True
+                    warnings.warn(f"effect {', '.join(names)} has no compiled element kernel: "
+                                  "the elements run on the numpy path (slower)", RuntimeWarning,
+                                  stacklevel=2)
         entry = cache[key]
         if entry is None:
             return None

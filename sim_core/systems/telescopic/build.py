@@ -84,8 +84,32 @@ class TelescopicSystem:
     ropes: list = field(default_factory=list)   # (extraction, retraction) RopeDrive per unit
     stages: list = field(default_factory=list)  # schedule of each stage k (boom k -> k+1)
     hoist: object = None                        # physics.hoist.HoistRope (payload_swing)
+
+    def section_outline(self, k: int) -> np.ndarray:
+        """Boom k's outer contour in section coordinates, m (for loads on its surface)."""
+        return _section_outline(self, k)
+
+    def exposed_elements(self) -> list:
+        """The spline elements outside the neighbouring booms: boom 1 whole, boom k > 1 beyond
+        its outer contact point (its second element)."""
+        beams = self.model.beams
+        return list(beams[0].elements) + [b.elements[-1] for b in beams[1:]]
     slew_angle: object = None                   # t -> slew angle (rad) where the crane slews
     i_phi: int | None = None                    # the turntable's slew-angle coordinate
+    plugin_effects: list = field(default_factory=list)  # (EffectPlugin, its Effect)
+
+
+def _section_outline(ts: "TelescopicSystem", k: int) -> np.ndarray:
+    """Boom k's outer contour (n, 2) in section coordinates (e_t, e_b), m: its section's, or
+    for the shorthand the U family's Table 1 contour (outer radii)."""
+    from sim_core.physics.cross_sections import cross_section
+    p = ts.params
+    if p.booms is not None:
+        return p.booms[k].section.outer
+    from sim_core.systems.telescopic.params import _Y_A, _WALL, family_radius
+    r = (0.09, 0.07, 0.05)[k] if p.n_booms <= 3 else family_radius(k, p.n_booms)
+    return cross_section({"shape": "u", "top_arc_centre_y": _Y_A, "top_arc_centre_z": _Y_A,
+                          "top_arc_radius": r, "wall": _WALL}, method="closed form").outer
 
 
 def drive_layout(n_booms: int, mechanism: str) -> tuple[list[int], list[int]]:
@@ -384,6 +408,15 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
                                      else None)
     if p.friction:
         model.multiplier_forces = [ts.contact]
+    # effect plug-ins switched on in the scene (sim_core.physics.plugins)
+    if p.plugin_tables:
+        from sim_core.physics.plugins import effect_plugins
+        plugins = effect_plugins()
+        for name, table in p.plugin_tables.items():
+            effect = plugins[name].build(table, ts)
+            model.effects.append(effect)
+            ts.plugin_effects.append((plugins[name], effect))
+        model.effects_changed()
     return ts
 
 
@@ -627,4 +660,6 @@ def _telescopic_result(ts: TelescopicSystem, t, ys, stats, error, scene=None):
     # the energies from them, simulate.telescopic_energy_check)
     outputs["state"] = np.asarray(ys, dtype=float)
     stats["n_dof"] = int(n)
+    if m.uncompiled_effects:
+        stats["uncompiled_effects"] = m.uncompiled_effects
     return Result(t, outputs, stats, scene if scene is not None else p.summary(), error)

@@ -101,6 +101,12 @@ def actuator_power(ts, t: float, Q, lam_luffing: float = 0.0) -> float:
     return P
 
 
+def plugin_power(ts, t: float, Q, Qd) -> float:
+    """The power (W) the effect plug-ins feed into the system (their registered ``power``)."""
+    return sum(plugin.power(effect, ts.model, t, Q, Qd)
+               for plugin, effect in ts.plugin_effects if plugin.power is not None)
+
+
 def _filter_power(m, filt, t, Q, Qd, Qdd) -> float:
     """Q_dot . (F_filter - M_filter Q_ddot), W, element by element."""
     P = 0.0
@@ -142,6 +148,7 @@ class AuditedSystem:
                 P["constraint_work"] -= float(lam @ J[:, self.ts.i_phi]) * float(Qd[self.ts.i_phi])
             if self.ts.hoist is not None:       # the hoist: a rope of prescribed length
                 P["constraint_work"] += self.ts.hoist.hoist_power(Q, t)
+            P["constraint_work"] += plugin_power(self.ts, t, Q, Qd)   # external loads
         if "drive_work" in self.terms:
             P["drive_work"] = float(sum(np.sum(lam[row] * np.atleast_1d(c.target(t)[1]))
                                         for c, row in self.drives))
@@ -149,6 +156,7 @@ class AuditedSystem:
                                               lam[self.ts.rows["luffing_cylinder"]][0])
             if self.ts.i_phi is not None:
                 P["drive_work"] += slew_power(self.ts, t, Q, Qd, lam)
+            P["drive_work"] += plugin_power(self.ts, t, Q, Qd)
         if "friction_work" in self.terms:
             P["friction_work"] = (float(Qd @ sum(mf.forces(t, Q, Qd, lam)
                                                  for mf in m.multiplier_forces))
@@ -224,7 +232,8 @@ def telescopic_energy_check(ts, res: Result) -> dict:
     audit = AuditedSystem(ts, ("drive_work",))
     n = audit.n
     E = np.array([mechanical_energy(ts, t, y[:n], y[n:2 * n]) for t, y in zip(ts_, Y)])
-    P = None if ts.i_phi is not None else _drive_power_of_outputs(ts, audit, res)
+    P = None if ts.i_phi is not None or ts.plugin_effects else \
+        _drive_power_of_outputs(ts, audit, res)
     if P is None:
         P = np.array([audit.powers(t, y[:n], y[n:2 * n])[1][0] for t, y in zip(ts_, Y)])
     elif ts.params.luffing_profile is not None or ts.hoist is not None:

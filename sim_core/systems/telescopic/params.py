@@ -4,7 +4,7 @@ six sections the same U-section family continued outwards (:func:`crane_sections
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from sim_core.physics.beam.moving_node_beam import BeamSection
 from sim_core.physics.sections import USection, section_properties
@@ -179,6 +179,7 @@ class TelescopicParams:
     hoist_length: float = 10.0              # m, unstretched hoist rope at t = 0
     hoist_EA: float = 2e8                   # N
     hook_mass: float = 500.0                # kg
+    plugin_tables: dict = field(default_factory=dict)  # effect plug-ins on: name -> table
 
     def __post_init__(self):
         if self.mechanism not in MECHANISMS:
@@ -215,7 +216,7 @@ class TelescopicParams:
     def summary(self, name: str = "telescopic") -> dict:
         """What a Result records as its scene where it was run from parameters, not a scene."""
         skip = ("sections", "booms", "overlaps", "luffing", "drive_profile", "luffing_profile",
-                "slew_profile", "hoist_profile")
+                "slew_profile", "hoist_profile", "plugin_tables")
         return {"kind": "telescopic", "name": name,
                 "params": {k: v for k, v in self.__dict__.items() if k not in skip}}
 

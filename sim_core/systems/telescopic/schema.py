@@ -107,6 +107,7 @@ from sim_core.scene.fields import (
     tables_of,
     vector,
 )
+from sim_core.physics.plugins import effect_plugins
 from sim_core.systems.telescopic import actuators
 from sim_core.systems.telescopic.params import (
     MAX_BOOMS,
@@ -119,7 +120,7 @@ from sim_core.systems.telescopic.params import (
 
 _TOP = {"kind", "name", "description", "solver", "booms", "drive", "payload", "ropes", "effects",
         "filtering", "gravity", "contact", "notes", "model", "boom", "overlap", "luffing",
-        "luffing_drive", "slew_drive", "hoist_drive", "hoist"}
+        "luffing_drive", "slew_drive", "hoist_drive", "hoist", *effect_plugins()}
 _GIVEN = ("A", "I_t", "I_b", "J", "mass_per_length", "y_c", "z_c")   # constants a table may give
 _PROFILE_KEYS = ("profile", "travel", "a_max", "j_max", "t_start", "table", "table_file",
                  "max_rate", "max_accel")
@@ -214,9 +215,10 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
     check_keys(r, {"EA"}, "ropes")
     sc["ropes"] = {"EA": number(r, "EA", "ropes", 1e8, lo=0.0, lo_open=True)}
     e = raw.get("effects", {})
+    plugins = effect_plugins()
     check_keys(e, {"gravity", "filtering", "friction", "contact_distribution", "torsion",
-                   "rope_elasticity", "flexible", "mass_centre_offset", "payload_swing"},
-               "effects")
+                   "rope_elasticity", "flexible", "mass_centre_offset", "payload_swing",
+                   *plugins}, "effects")
     three = sc["booms"]["count"] == 3 or bool(boom_tables)
     sc["effects"] = {"flexible": boolean(e, "flexible", "effects", True),
                      "torsion": boolean(e, "torsion", "effects", True),
@@ -227,6 +229,9 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
                      "rope_elasticity": boolean(e, "rope_elasticity", "effects", True),
                      "mass_centre_offset": boolean(e, "mass_centre_offset", "effects", False),
                      "payload_swing": boolean(e, "payload_swing", "effects", False)}
+    for name in plugins:                # effect plug-ins (sim_core.physics.plugins): off unless on
+        if name in e:
+            sc["effects"][name] = boolean(e, name, "effects", False)
     eff = sc["effects"]
     if boom_tables and not (eff["flexible"]
                             and raw.get("model", {}).get("reduction", "none") == "none"):
@@ -342,6 +347,13 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
                              "false or model.reduction = 'modal': the rigid limit and the modal "
                              "tables have a fixed luffing angle and a fixed payload (allowed: "
                              "flexible booms with model.reduction = 'none')")
+    for name, plugin in plugins.items():
+        tb = table_of(raw, name, "")
+        if tb and not sc["effects"].get(name, False):
+            raise SceneError(f"[{name}] with effects.{name} = false: the table configures the "
+                             f"{name} effect (allowed: effects.{name} = true, or leave it out)")
+        if sc["effects"].get(name, False):
+            sc[name] = plugin.validate(tb, sc)
     mo = raw.get("model", {})
     check_keys(mo, {"reduction", "n_modes"}, "model")
     sc["model"] = {"reduction": choice(mo, "reduction", "model", ("none", "modal"), "none"),
@@ -688,7 +700,9 @@ def params_from_scene(sc: dict):
         profiles[key] = (actuators.build_profile({**sc[table], "_table": table}, s0, table, src)
                          if sc.get(table) else None)
     hoist = sc.get("hoist", {})
+    plugin_tables = {name: sc[name] for name in effect_plugins() if sc["effects"].get(name)}
     return TelescopicParams(
+        plugin_tables=plugin_tables,
         **profiles, payload_swing=sc["effects"].get("payload_swing", False),
         hoist_length=hoist.get("length", 10.0), hoist_EA=hoist.get("EA", 2e8),
         hook_mass=hoist.get("hook_mass", 500.0),
