@@ -229,17 +229,24 @@ class _Walker(ast.NodeVisitor):
                     self.out["gets"].setdefault(node.args[0].value, text)
         elif f is not None and f in self.funcs and (f == "solver_table" or f.startswith("_check")):
             fn, _, mod_consts = self.funcs[f]
-            # the registry goes down with the walk, so a _check helper may call another
-            sub = _Walker(self.modules, self.funcs, mod_consts, self.out,
-                          params=[a.arg for a in fn.args.args])
-            # a table path passed as an argument (``_check_actuator(d, "luffing_drive")``)
-            # names the table of the keys the helper checks: one walk per call
+            # a table path passed as an argument (``_check_actuator(d, "luffing_drive")``, or a
+            # loop variable over such names) names the table of the keys the helper checks:
+            # one walk per path
+            bindings = [{}]
             for formal, actual in zip(fn.args.args, node.args):
                 path = self.path_of(actual)
                 if path is not None and re.fullmatch(r"[\w.\[\]{}]*", path):
-                    sub.env[formal.arg] = ("path", path)
-            for s in fn.body:
-                sub.visit(s)
+                    bindings = [{**b, formal.arg: ("path", path)} for b in bindings]
+                elif self.keys_of(actual) and isinstance(actual, ast.Name):
+                    bindings = [{**b, formal.arg: ("path", k)} for b in bindings
+                                for k in self.keys_of(actual)]
+            for env in bindings:
+                # the registry goes down with the walk, so a _check helper may call another
+                sub = _Walker(self.modules, self.funcs, mod_consts, self.out,
+                              params=[a.arg for a in fn.args.args])
+                sub.env.update(env)
+                for s in fn.body:
+                    sub.visit(s)
         self.generic_visit(node)
 
     def visit_Raise(self, node):
@@ -509,6 +516,24 @@ def _kind_section(title, kind, modname, funcname, minimal) -> str:
     walker = _Walker([mod, scene_mod], registry, consts, out)
     for s in funcs[funcname].body:
         walker.visit(s)
+    # effect plug-ins (sim_core.physics.plugins) of the telescopic kind: their validators'
+    # keys, and their units from the validator's docstring as the segment of their table
+    plugin_docs = {}
+    if kind == "telescopic":
+        from sim_core.physics.plugins import effect_plugins
+        for name, plugin in effect_plugins().items():
+            pmod, pfuncs, pconsts = _module_info(plugin.validate.__module__)
+            preg = dict(registry)
+            preg.update({n: (fn, pfuncs, pconsts) for n, fn in pfuncs.items()})
+            pwalker = _Walker([pmod, scene_mod], preg, pconsts, out)
+            for st in pfuncs[plugin.validate.__name__].body:
+                pwalker.visit(st)
+            doc = " ".join((plugin.validate.__doc__ or "").split())
+            plugin_docs[name] = doc.split(":", 1)[1] if ":" in doc else doc
+            out["items"].append({"helper": "boolean", "where": "effects", "key": name,
+                                 "optional": False, "default": False,
+                                 "default_kind": "literal", "range": "true, false",
+                                 "type": "boolean"})
 
     validate = getattr(mod, funcname)
     try:
@@ -525,6 +550,7 @@ def _kind_section(title, kind, modname, funcname, minimal) -> str:
         for name, text in _segments(m.__doc__ or "").items():
             docs.setdefault(name, text)
     own_docs = _segments(mod.__doc__ or "")
+    own_docs.update(plugin_docs)
 
     # tables in order of first appearance, keys in the order of the table's check_keys set;
     # keys of a check_keys set without a typed helper call get a row too

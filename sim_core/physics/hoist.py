@@ -23,6 +23,8 @@ from typing import Callable
 
 import numpy as np
 
+from sim_core.physics.point_effects import path_length
+
 __all__ = ["free_point", "HangingMass", "HoistRope"]
 
 
@@ -99,11 +101,7 @@ class HoistRope:
 
     def span(self, Q):
         """(l, dl/dQ): the distance tip-payload, m, and its gradient."""
-        rt, Jt, _, _ = self.top(Q)
-        rp, Jp, _, _ = self.bottom(Q)
-        d = rp - rt
-        ell = np.sqrt(d @ d)
-        return ell, (d / ell) @ (Jp - Jt)
+        return path_length(self.points, Q)
 
     def tension(self, ell: float, t: float) -> float:
         """T (N) at span ell (m) and time t: tension-only with a C1 ramp over slack_width."""

@@ -50,6 +50,20 @@ class PointMass:
         _add_local(self.local(t, Q, Qd, M is not None), M, F)
 
 
+def path_length(points, Q):
+    """(l, dl/dQ): the length (m) of the polyline through the points' positions at Q and its
+    gradient (complex-step safe)."""
+    pts = [p(Q) for p in points]
+    ell = 0.0
+    grad = np.zeros(len(Q))
+    for (ra, Ja, _, _), (rb, Jb, _, _) in zip(pts[:-1], pts[1:]):
+        d = rb - ra
+        n = np.sqrt(d @ d)
+        ell = ell + n
+        grad = grad + (d / n) @ (Jb - Ja)
+    return ell, grad
+
+
 @dataclass
 class RopeDrive:
     """Elastic, massless, tension-only rope over frictionless point pulleys (Section 9;
@@ -74,15 +88,7 @@ class RopeDrive:
         return np.zeros(0, dtype=int)
 
     def length(self, Q):
-        pts = [p(Q) for p in self.points]
-        ell = 0.0
-        grad = np.zeros(len(Q))
-        for (ra, Ja, _, _), (rb, Jb, _, _) in zip(pts[:-1], pts[1:]):
-            d = rb - ra
-            n = np.sqrt(d @ d)
-            ell = ell + n
-            grad = grad + (d / n) @ (Jb - Ja)
-        return ell, grad
+        return path_length(self.points, Q)
 
     def tension(self, ell):
         k = self.EA / self.L0

@@ -290,3 +290,26 @@ def static_luffing_forces(theta: float, L_s: float, payload_mass: float, *,
     F_L = -M / arm
     T = (masses[2] + payload_mass) * g * math.sin(theta)
     return StaticLuffingForces(F_L, M, geo.lever, T, masses[1] * g * math.sin(theta) + 2 * T)
+
+
+def rigid_luffing_force(p, theta: float, g: float) -> float:
+    """Cylinder force (N, > 0 pushing) of the rigid crane of TelescopicParams ``p`` at the
+    luffing angle theta (rad) by virtual work, for any lengths and mounting points: a virtual
+    rotation d(theta) about the pivot D1 does work -sum W_i dz_i with the weights W_i (booms at
+    their mid-length on the reference line, the payload at the tip), and the cylinder, whose length
+    changes by d(L_cyl) = lever d(theta), does F lever d(theta); so F = M_D1 / lever with
+    M_D1 = sum W_i (x_i - x_D1), the weights' moment about D1 (horizontal arms)."""
+    from sim_core.systems.telescopic.params import boom_section
+    geo = luffing_geometry(theta, *p.luffing.points())
+    e = geo.e_s
+    a = [k * p.stroke0 for k in range(p.n_booms)]          # left sections along boom 1
+    arms = [(geo.origin + (a[k] + 0.5 * p.lengths[k]) * e)[0] - geo.d1[0]
+            for k in range(p.n_booms)]
+    weights = [p.lengths[k] * boom_section(k, p).rhoA * g for k in range(p.n_booms)]
+    tip_arm = (geo.origin + (a[-1] + p.lengths[-1]) * e)[0] - geo.d1[0]
+    M = sum(W * x for W, x in zip(weights, arms)) + p.payload * g * tip_arm
+    # the sign: d(L_cyl)/d(theta) > 0 when lifting lengthens the cylinder (a pushing cylinder)
+    d = 1e-6
+    dL = (luffing_geometry(theta + d, *p.luffing.points()).cylinder_length
+          - luffing_geometry(theta - d, *p.luffing.points()).cylinder_length) / (2 * d)
+    return M / dL

@@ -4,7 +4,6 @@ that swings on its hoist rope, against hand calculations."""
 from __future__ import annotations
 
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -17,9 +16,8 @@ from sim_core.systems.telescopic.build import build_telescopic, initial_equilibr
 from sim_core.systems.telescopic.luffing import cylinder_length
 from sim_core.systems.telescopic.params import LuffingSpec
 from sim_core.systems.telescopic.schema import params_from_scene
+from sim_core.validation.closed_form import rigid_luffing_force
 
-sys.path.insert(0, str(Path(__file__).parent))
-from test_user_crane import _rigid_luffing_force  # noqa: E402  (the virtual-work statics)
 
 HOLD = {"drive.profile": "table", "drive.table": [[0.0, 2.0], [1.0, 2.0]]}   # stages held
 
@@ -161,7 +159,7 @@ def test_luffing_cylinder_force_along_a_slow_luffing_motion():
     constant (t >= 2.5 s: the ramp's vibration decayed by the stress filter) the angular
     acceleration is zero and the centrifugal forces act through the pivot, so the cylinder
     force is the rigid crane's virtual-work statics at the profile's angle
-    (test_user_crane._rigid_luffing_force) within 1 % (the booms' deflection moves the weights'
+    (closed_form.rigid_luffing_force) within 1 % (the booms' deflection moves the weights'
     arms by ~0.1 %).  In the ramps the d'Alembert moment of the angular acceleration adds its
     3-4 %: the force is not compared there."""
     sc = load_scene("telescopic_extraction", overrides={
@@ -177,7 +175,7 @@ def test_luffing_cylinder_force_along_a_slow_luffing_motion():
         th_rigid = float(p.luffing_profile.sample(tk).s)
         assert th == pytest.approx(th_rigid, abs=math.radians(0.1))     # the booms' sag
         if tk >= 2.5:
-            assert F == pytest.approx(_rigid_luffing_force(p, th_rigid, 9.81), rel=1e-2)
+            assert F == pytest.approx(rigid_luffing_force(p, th_rigid, 9.81), rel=1e-2)
 
 
 # -- the payload on the hoist rope -----------------------------------------------------------

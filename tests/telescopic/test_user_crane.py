@@ -20,6 +20,7 @@ from sim_core.systems.telescopic.build import build_telescopic, initial_equilibr
 from sim_core.systems.telescopic.luffing import luffing_geometry
 from sim_core.systems.telescopic.params import TABLE2, Z_C_TABLE2, boom_section
 from sim_core.systems.telescopic.schema import params_from_scene, validate_telescopic
+from sim_core.validation.closed_form import rigid_luffing_force
 from sim_core.systems.telescopic.sliders import slider_geometries
 
 
@@ -91,27 +92,6 @@ def test_two_section_tip_deflection_matches_stepped_beam():
     assert delta_model == pytest.approx(delta_hand, rel=1e-2)
 
 
-def _rigid_luffing_force(p, theta: float, g: float) -> float:
-    """Cylinder force (N, > 0 pushing) of the rigid crane by virtual work: a virtual rotation
-    d(theta) about the pivot D1 does work -sum W_i dz_i with the weights W_i (booms at their
-    mid-length on the reference line, the payload at the tip), and the cylinder, whose length
-    changes by d(L_cyl) = lever d(theta), does F lever d(theta); so F = M_D1 / lever with
-    M_D1 = sum W_i (x_i - x_D1), the weights' moment about D1 (horizontal arms)."""
-    geo = luffing_geometry(theta, *p.luffing.points())
-    e = geo.e_s
-    a = [k * p.stroke0 for k in range(p.n_booms)]          # left sections along boom 1
-    arms = [(geo.origin + (a[k] + 0.5 * p.lengths[k]) * e)[0] - geo.d1[0]
-            for k in range(p.n_booms)]
-    weights = [p.lengths[k] * boom_section(k, p).rhoA * g for k in range(p.n_booms)]
-    tip_arm = (geo.origin + (a[-1] + p.lengths[-1]) * e)[0] - geo.d1[0]
-    M = sum(W * x for W, x in zip(weights, arms)) + p.payload * g * tip_arm
-    # the sign: d(L_cyl)/d(theta) > 0 when lifting lengthens the cylinder (a pushing cylinder)
-    d = 1e-6
-    dL = (luffing_geometry(theta + d, *p.luffing.points()).cylinder_length
-          - luffing_geometry(theta - d, *p.luffing.points()).cylinder_length) / (2 * d)
-    return M / dL
-
-
 GEOMETRIES = {
     "low pivot, long lever": {"pivot": [-1.0, 2.6], "pivot_on_boom": [0.0, -0.4],
                               "base": [0.9, 0.3], "head_on_boom": [4.5, -0.45]},
@@ -126,7 +106,7 @@ GEOMETRIES = {
 @pytest.mark.parametrize("angle", [20.0, 45.0, 75.0])
 def test_luffing_cylinder_force_matches_virtual_work(geometry, angle):
     """Luffing-cylinder force at t = 0 for user mounting points at 20, 45 and 75 deg against the
-    virtual-work statics of the rigid crane (:func:`_rigid_luffing_force`).  The booms are
+    virtual-work statics of the rigid crane (closed_form.rigid_luffing_force).  The booms are
     stiff (E = 2.1e14 Pa, 1000 x steel), so the deflection moves the weights' arms by
     ~1e-5 of the reach; ropes and the telescopic cylinder are internal forces and drop out.
     Tolerance 0.5 % (the issue's)."""
@@ -139,7 +119,7 @@ def test_luffing_cylinder_force_matches_virtual_work(geometry, angle):
     ts = build_telescopic(p)
     _, lam = initial_equilibrium(ts)
     force = lam[ts.rows["luffing_cylinder"]][0]
-    ref = _rigid_luffing_force(p, math.radians(angle), 9.81)
+    ref = rigid_luffing_force(p, math.radians(angle), 9.81)
     assert force == pytest.approx(ref, rel=5e-3)       # > 0: the cylinder pushes
 
 

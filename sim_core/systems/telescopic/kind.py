@@ -9,6 +9,7 @@ from pathlib import Path
 from sim_core.figures import plot_result
 from sim_core.result import Result
 from sim_core.systems.telescopic.build import build_telescopic, simulate_telescopic
+from sim_core.systems.telescopic.build import stage_schedules
 from sim_core.systems.telescopic.modal import simulate_modal
 from sim_core.systems.telescopic.plots import plot_telescopic
 from sim_core.systems.telescopic.rigid import RigidTelescopic
@@ -53,9 +54,20 @@ def describe(scene: dict) -> list[str]:
     lines.append(f"luffing cylinder: {props['luffing_cylinder_length']:.4g} m, lever "
                  f"{props['luffing_lever']:.4g} m about the pivot D1 at "
                  f"{props['luffing_angle_deg']:g} deg")
+    for table, a in props["actuators"].items():
+        lines.append(f"{a['actuator']} ({table}, {a['profile']}): largest rate "
+                     f"{a['max_rate']:.4g} {a['unit']}/s at t = {a['t_max_rate']:.4g} s, "
+                     f"largest acceleration {a['max_accel']:.4g} {a['unit']}/s^2 at t = "
+                     f"{a['t_max_accel']:.4g} s")
     if system.contact is not None and not system.params.friction:
         lines.append("note: slider-spring distribution evaluated for the outputs only (friction off)")
     return lines + system.model.describe()
+
+
+def build_schedule(p):
+    """The telescopic stages' schedule (the first stage's; every stage of the synchronized
+    drive has it)."""
+    return stage_schedules(p)[0]
 
 
 def properties(scene: dict) -> dict:
@@ -63,7 +75,8 @@ def properties(scene: dict) -> dict:
     length (m), A (m^2), I_t, I_b, J (m^4), mass_per_length (kg/m), mass centre (y_c, z_c) (m),
     E, G (Pa), rho (kg/m^3) and where the constants come from; the luffing cylinder's length and
     its lever about the pivot D1 at the scene's luffing angle (``luffing_lever``, m); the
-    sliders of every overlap."""
+    sliders of every overlap; every moving actuator's profile with its largest rate and
+    acceleration and their times (in the scene's units: m or deg)."""
     import math
 
     from sim_core.systems.telescopic.luffing import luffing_geometry
@@ -90,7 +103,19 @@ def properties(scene: dict) -> dict:
         booms.append({k2: (float(v) if isinstance(v, (int, float)) else v)
                       for k2, v in row.items()})
     geo = luffing_geometry(math.radians(p.luffing_angle_deg), *p.luffing.points())
-    return {"booms": booms,
+    from sim_core.systems.telescopic import actuators as act
+    moving = {}
+    t_end = scene["solver"]["t_end"]
+    for table, prof in (("drive", p.drive_profile or build_schedule(p)),
+                        ("luffing_drive", p.luffing_profile), ("slew_drive", p.slew_profile),
+                        ("hoist_drive", p.hoist_profile)):
+        if prof is None:
+            continue
+        limits = act.check_limits(table, scene.get(table, {}), prof, t_end)
+        moving[table] = {"actuator": act.ACTUATORS[table][0],
+                         "profile": scene.get(table, {}).get("profile", "cubic"), **limits}
+    return {"actuators": moving,
+            "booms": booms,
             "luffing_angle_deg": p.luffing_angle_deg,
             "luffing_lever": geo.lever,
             "luffing_cylinder_length": geo.cylinder_length,

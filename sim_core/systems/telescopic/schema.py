@@ -15,6 +15,30 @@
                mechanism ("synchronized" default: the paper's cylinder-and-rope unit repeated
                along the boom, every stage moves together; "sequential": one cylinder moves
                one stage at a time, the others pinned; docs/model.md, "N-boom drives")
+               profile ("cubic" default: the keys above; "trapezoid": travel m (> 0, with
+               direction), v_max m/s, a_max m/s^2 (> 0), j_max m/s^3 (> 0, optional: a jerk-
+               limited S-curve); "table": table (rows [time s, stage length m], the first row
+               is booms.stroke0) or table_file (a CSV file of time s and stage length m,
+               relative to the scene file)), t_start s (>= 0: when the cubic or trapezoid
+               starts), max_rate m/s (> 0) and max_accel m/s^2 (> 0): the actuator's limits,
+               checked against the profile (sim_core.systems.telescopic.actuators)
+  [luffing_drive] the luffing cylinder's profile in the luffing angle of the rigid crane, from
+               booms.luffing_angle_deg: profile ("hold" default, "cubic", "trapezoid",
+               "table"), travel deg (signed), t_ramp s (> 0), t_hold_end s (>= t_ramp),
+               t_start s (>= 0), v_max deg/s (> 0), a_max deg/s^2 (> 0), j_max deg/s^3 (> 0),
+               table (rows [time s, angle deg]) or table_file, max_rate deg/s (> 0),
+               max_accel deg/s^2 (> 0); the angle stays in [0, 85] deg
+  [slew_drive] the slewing drive's profile in the slew angle about the vertical from 0 (a
+               turntable under the pivot and the cylinder base): profile, travel deg,
+               t_ramp s, t_hold_end s, t_start s, v_max deg/s, a_max deg/s^2, j_max deg/s^3,
+               table or table_file (time s, angle deg), max_rate deg/s, max_accel deg/s^2,
+               as in [luffing_drive]
+  [hoist_drive] the hoist's profile in the unstretched hoist-rope length from hoist.length
+               (at least 0.1 m): profile, travel m, t_ramp s, t_hold_end s, t_start s,
+               v_max m/s, a_max m/s^2, j_max m/s^3, table or table_file (time s, length m),
+               max_rate m/s, max_accel m/s^2, as in [luffing_drive]
+  [hoist]      with effects.payload_swing: length m (> 0, unstretched at t = 0), EA N (> 0),
+               hook_mass kg (>= 0, hangs with the payload)
   [payload]    mass kg (>= 0)
   [ropes]      EA N (> 0)
   [effects]    what is off is not built (each a separate contribution to the model):
@@ -28,6 +52,10 @@
                slider_contact_forces; false = only the constraint resultants),
                rope_elasticity (bool, default true: elastic tension-only ropes with [ropes] EA;
                false = one inextensible rope constraint, output rope_tension),
+               payload_swing (bool, default false: the payload and hook hang on the elastic
+               hoist rope of [hoist] and swing; false = a point mass fixed at the tip),
+               wind (bool, default false: an effect plug-in, the drag of [wind] on the exposed
+               booms, sim_core.physics.wind),
                mass_centre_offset (bool, default false: mass on the reference line; true =
                the Table 2 offsets z_c = 0.045/0.044/0.043 m as a rigid offset in inertia and
                gravity, docs/model.md#input-sections; the modal ROM tables are built without it)
@@ -189,7 +217,7 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
         ls_lo, ls_hi = sorted((sc["booms"]["stroke0"], end))
     else:
         if sc["drive"]["profile"] == "table":
-            t_tab, s_tab = actuators.table_rows(sc["drive"], source)
+            _, s_tab = actuators.table_rows(sc["drive"], source)
             if "stroke0" in b and b["stroke0"] != s_tab[0]:
                 raise SceneError(f"booms.stroke0 = {b['stroke0']:g} m and the drive table starts "
                                  f"at L_s = {s_tab[0]:g} m (allowed: equal, or leave stroke0 "
@@ -383,9 +411,11 @@ def _check_actuator(d: dict, table: str, default: str) -> dict:
     """The drive profile of an actuator table (sim_core.systems.telescopic.actuators): its kind
     and the kind's keys, positions in the table's unit (m or deg), rates per s.  The telescopic
     [drive] keeps its cubic keys (direction, v_max, t_ramp, t_hold_end) beside these."""
-    kinds = ("cubic", "trapezoid", "table") if table == "drive" else \
-        ("hold", "cubic", "trapezoid", "table")
-    out = {"profile": choice(d, "profile", table, kinds, default)}
+    out = {"profile": choice(d, "profile", table, ("hold", "cubic", "trapezoid", "table"),
+                             default)}
+    if table == "drive" and out["profile"] == "hold":
+        raise SceneError("drive.profile = 'hold': the telescopic stages hold with a table of "
+                         "one length (allowed: 'cubic', 'trapezoid', 'table')")
     kind = out["profile"]
     lo_travel = 0.0 if table == "drive" else None        # [drive]: a length, with direction
     if kind in ("cubic", "trapezoid") and "t_start" in d:
