@@ -20,7 +20,9 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 
 from sim_core._version import __version__  # noqa: E402
 from sim_core.api import load_scene, simulate  # noqa: E402
-from sim_core.errors import SceneError, SimulationError  # noqa: E402
+from sim_core.errors import ResultFormatError, SceneError, SimulationError  # noqa: E402
 from sim_core.result import Result  # noqa: E402
+from sim_core.simulation import Simulation  # noqa: E402
 
-__all__ = ["load_scene", "simulate", "Result", "SceneError", "SimulationError", "__version__"]
+__all__ = ["load_scene", "simulate", "Simulation", "Result", "ResultFormatError", "SceneError",
+           "SimulationError", "__version__"]

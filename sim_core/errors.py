@@ -9,6 +9,25 @@ class SceneError(ValueError):
     """Invalid scene input; the message names the field, the value and the allowed range."""
 
 
+class ResultFormatError(ValueError):
+    """A result file (``result.npz``) that :meth:`sim_core.result.Result.load` cannot read: not a
+    result file, truncated or corrupted, or written in a result format this version does not
+    read.  The message is one line, ``PATH: what is wrong``.
+
+    Attributes
+    ----------
+    path : str
+        The file.
+    problem : str
+        What is wrong with it.
+    """
+
+    def __init__(self, path, problem: str):
+        self.path = str(path)
+        self.problem = " ".join(str(problem).split())
+        super().__init__(f"{self.path}: {self.problem}")
+
+
 class SimulationError(RuntimeError):
     """A solve failed.
 

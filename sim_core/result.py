@@ -11,6 +11,8 @@ from typing import Any
 
 import numpy as np
 
+from sim_core.errors import ResultFormatError
+
 
 def atomic_write_bytes(path: str | Path, data: bytes) -> None:
     """Write ``data`` to ``path`` through a temporary file in the same folder + rename.
@@ -130,7 +132,8 @@ class Result:
         return self.outputs.keys()
 
     def save(self, path: str | Path) -> Path:
-        """Write an .npz (arrays + JSON metadata) atomically."""
+        """Write an .npz (arrays + JSON metadata) atomically, in result format
+        :data:`RESULT_FORMAT` (see :meth:`load` for the layout)."""
         import io
 
         from sim_core._version import __version__
@@ -142,14 +145,118 @@ class Result:
         except ImportError:  # pragma: no cover
             pass
         buf = io.BytesIO()
-        np.savez_compressed(buf, t=self.t, __meta__=np.array(json.dumps(meta, default=json_default)),
+        np.savez_compressed(buf, **{_FORMAT_MEMBER: np.array(RESULT_FORMAT, dtype=np.int64)},
+                            t=self.t, __meta__=np.array(json.dumps(meta, default=json_default)),
                             **{f"out__{k}": v for k, v in self.outputs.items()})
         atomic_write_bytes(path, buf.getvalue())
         return Path(path)
 
     @classmethod
     def load(cls, path: str | Path) -> "Result":
-        with np.load(path, allow_pickle=False) as z:
-            meta = json.loads(str(z["__meta__"]))
-            outs = {k[5:]: z[k] for k in z.files if k.startswith("out__")}
-            return cls(z["t"], outs, meta.get("stats", {}), meta.get("scene", {}), meta.get("error"))
+        """Read a result file written by :meth:`save`.
+
+        The file is an .npz (a zip of .npy arrays): ``__format__`` (the result format, an
+        integer), ``t``, ``__meta__`` (JSON text: stats, scene, error, package versions) and one
+        ``out__NAME`` per output.  Files written before the format was versioned have no
+        ``__format__`` member and are otherwise laid out exactly as format 1: they are read as
+        result format 0.
+
+        Raises :class:`sim_core.errors.ResultFormatError` (a ``ValueError``), with a one-line
+        message naming the file and what is wrong, for a file this version cannot read: one
+        written in a newer or an unknown result format, a file that is not a result file
+        (not a zip, a zip without our members), a truncated or corrupted file (a damaged
+        member, a missing array, unreadable metadata).  A file that cannot be opened at all
+        (missing, a directory, no permission) raises the usual ``OSError``.
+        """
+        with open(path, "rb") as f:                      # OSError: missing file, permissions
+            return cls._read(f, path)
+
+    @classmethod
+    def _read(cls, f, path) -> "Result":
+        def bad(problem: str) -> ResultFormatError:
+            return ResultFormatError(path, problem)
+
+        head = f.read(4)
+        if not head:
+            raise bad("empty file (not a result file)")
+        if head != b"PK\x03\x04":
+            raise bad("not a result file (not an .npz/zip archive)")
+        f.seek(0)
+        try:
+            z = np.load(f, allow_pickle=False)
+        except _DECODE_ERRORS as exc:
+            raise bad(f"truncated or corrupted: not a readable zip archive ({_why(exc)})") from None
+        if not isinstance(z, np.lib.npyio.NpzFile):  # pragma: no cover - head says zip
+            raise bad("not a result file (not an .npz archive)")
+        with z:
+            names = set(z.files)
+            if _FORMAT_MEMBER not in names and "__meta__" not in names:
+                listed = ", ".join(sorted(names)[:5]) + (", ..." if len(names) > 5 else "")
+                raise bad("not a telescopic-boom-sim result file (no result format version nor "
+                          f"metadata; members: {listed or 'none'})")
+
+            def member(name: str) -> np.ndarray:
+                if name not in names:
+                    raise bad(f"truncated or corrupted: missing array {name!r}")
+                try:
+                    return z[name]
+                except _DECODE_ERRORS as exc:
+                    raise bad(f"truncated or corrupted: cannot read array {name!r} "
+                              f"({_why(exc)})") from None
+
+            version = 0
+            if _FORMAT_MEMBER in names:
+                v = member(_FORMAT_MEMBER)
+                if v.shape != () or v.dtype.kind not in "iu":
+                    raise bad(f"corrupted: the result format version is not an integer "
+                              f"({v.dtype}, shape {v.shape})")
+                version = int(v)
+            if version > RESULT_FORMAT:
+                raise bad(f"written by result format {version}, this version of "
+                          f"telescopic-boom-sim reads format {RESULT_FORMAT} (upgrade the package)")
+            if version < OLDEST_RESULT_FORMAT:
+                raise bad(f"unknown result format {version}, this version of telescopic-boom-sim "
+                          f"reads formats {OLDEST_RESULT_FORMAT} to {RESULT_FORMAT}")
+
+            raw = member("__meta__")
+            if raw.shape != () or raw.dtype.kind != "U":
+                raise bad(f"corrupted metadata: '__meta__' is not JSON text ({raw.dtype}, "
+                          f"shape {raw.shape})")
+            try:
+                meta = json.loads(str(raw))
+            except ValueError as exc:                    # json.JSONDecodeError
+                raise bad(f"unreadable JSON metadata ({_why(exc)})") from None
+            if not isinstance(meta, dict):
+                raise bad(f"corrupted metadata: a JSON {type(meta).__name__}, not an object")
+            stats, scene, error = meta.get("stats", {}), meta.get("scene", {}), meta.get("error")
+            for key, value, kind in (("stats", stats, dict), ("scene", scene, dict),
+                                     ("error", error, (str, type(None)))):
+                if not isinstance(value, kind):
+                    raise bad(f"corrupted metadata: {key!r} is a JSON {type(value).__name__}")
+
+            t = member("t")
+            if t.ndim != 1 or t.dtype.kind not in "fiu":
+                raise bad(f"corrupted: the time array 't' is not a 1-D numeric array "
+                          f"({t.dtype}, shape {t.shape})")
+            outs = {k[5:]: member(k) for k in z.files if k.startswith("out__")}
+        return cls(t, outs, stats, scene, error)
+
+
+#: The result format :meth:`Result.save` writes.  Bump it when the layout of ``result.npz``
+#: changes in a way an older reader would misread, and teach :meth:`Result.load` the old one.
+#: 1: a ``__format__`` member added to the unversioned layout (format 0), nothing else changed.
+RESULT_FORMAT = 1
+#: The oldest result format :meth:`Result.load` reads (0: files written before versioning).
+OLDEST_RESULT_FORMAT = 0
+_FORMAT_MEMBER = "__format__"
+# A damaged archive or member fails in zipfile, zlib or numpy's .npy reader with whatever it
+# meets first (BadZipFile for a bad CRC or header, zlib.error, ValueError, EOFError, struct.error,
+# tokenize.TokenError for a garbled .npy header, ...): every failure to decode the bytes is
+# caught (only there) and reported as a damaged file.
+_DECODE_ERRORS = (Exception,)
+
+
+def _why(exc: BaseException) -> str:
+    """The low-level reason in one line (its type when it has no text)."""
+    text = " ".join(str(exc).split())
+    return text or type(exc).__name__

@@ -148,7 +148,10 @@ def solver_table(s: dict, t_end=None, atol: float = 1e-8, n_output: int = 201,
             out[key] = number(s, key, "solver", lo=0.0, lo_open=True)
     if out["method"] == "generalized_alpha":
         if "h" in s:
-            out["h"] = number(s, "h", "solver", lo=0.0, hi=out["t_end"], lo_open=True)
+            # at least 1e-7 s and at most 1e7 steps: a step below that cannot finish in any
+            # wall budget (and one compiled call per output interval must return in time)
+            h_lo = max(1e-7, out["t_end"] / 1e7)
+            out["h"] = number(s, "h", "solver", lo=h_lo, hi=out["t_end"])
             if "h_max" in s:
                 raise SceneError(f"solver.h_max = {s['h_max']!r}: only the error-controlled "
                                  f"steps (no solver.h) have an h_max; solver.h = {s['h']!r} "

@@ -31,9 +31,11 @@ def test_shipped_telescopic_scenes_are_valid(name):
 @pytest.mark.parametrize("key, value, allowed", [
     ("booms.length", 0.0, "(0, inf)"),
     ("booms.length", -10.0, "(0, inf)"),
-    ("booms.E", 0.0, "(0, inf)"),
-    ("booms.rho", -7850.0, "(0, inf)"),
-    ("payload.mass", -1.0, "[0, inf)"),
+    ("booms.E", 0.0, "[1e+08, 1e+15]"),
+    ("booms.E", 1e-300, "[1e+08, 1e+15]"),
+    ("booms.rho", -7850.0, "[10, 100000]"),
+    ("payload.mass", -1.0, "[0, 2e+06]"),
+    ("payload.mass", 1e12, "[0, 2e+06]"),
     ("ropes.EA", 0.0, "(0, inf)"),
     ("contact.k0", 0.0, "(0, inf)"),
     ("contact.eps", 0.0, "(0, inf)"),
@@ -201,3 +203,22 @@ def test_cli_runs_the_fast_fidelities(tmp_path, args):
     for key in ("tip_position", "piston_stroke"):
         assert np.all(np.isfinite(res[key]))
     assert (out / "summary.json").exists()
+
+
+@pytest.mark.parametrize("key, value, allowed", [
+    ("payload.mass", 7.0, "[20000, 30000]"),
+    ("booms.luffing_angle_deg", 30.0, "[45, 75]"),
+])
+def test_modal_scene_refuses_values_outside_its_tables(key, value, allowed):
+    """The modal ROM's tables cover 20-30 t and 45-75 deg: the validator names the range
+    before the run (a value outside failed at run time with a traceback)."""
+    msg = _err({key: value}, scene="telescopic_extraction_rl")
+    assert msg.startswith(f"{key} = {value!r}") and allowed in msg
+
+
+def test_fixed_step_below_its_floor_is_refused():
+    """A generalized-alpha step below 1e-7 s (or more than 1e7 steps) cannot finish in any
+    budget: the validator refuses it naming the allowed range."""
+    with pytest.raises(SceneError) as info:
+        load_scene("beam_through_sleeve", overrides={"solver.h": 1e-9, "solver.t_end": 0.2})
+    assert "solver.h = 1e-09" in str(info.value) and "[1e-07, 0.2]" in str(info.value)

@@ -16,7 +16,7 @@ from sim_core.systems.telescopic.rigid import RigidTelescopic
 from sim_core.systems.telescopic.schema import params_from_scene
 from sim_core.systems.telescopic.schema import validate_telescopic as validate
 
-__all__ = ["validate", "build", "run", "describe", "figures", "properties"]
+__all__ = ["validate", "build", "run", "describe", "figures", "properties", "stepper"]
 
 
 def build(scene: dict):
@@ -132,3 +132,9 @@ def properties(scene: dict) -> dict:
 def figures(result: Result, out: Path) -> list[Path]:
     """Tip motion, the rigid-limit comparison, contact-point forces and slider loads."""
     return plot_result(result, out) + plot_telescopic(result, out)
+
+
+def stepper(scene: dict):
+    """The scene's model advanced step by step (sim_core.Simulation)."""
+    from sim_core.systems.telescopic.stepping import TelescopicStepper
+    return TelescopicStepper(scene)

@@ -170,8 +170,9 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
     if boom_tables and b.get("count", len(boom_tables)) != len(boom_tables):
         raise SceneError(f"booms.count = {b['count']!r} with {len(boom_tables)} [[boom]] tables: "
                          "the count must equal the number of tables (or be left out)")
-    E = number(b, "E", "booms", 2.1e11, lo=0.0, lo_open=True)
-    rho = number(b, "rho", "booms", 7850.0, lo=0.0, lo_open=True)
+    # physical ranges: from soft polymers to ten times diamond, from foams to osmium
+    E = number(b, "E", "booms", 2.1e11, lo=1e8, hi=1e15)
+    rho = number(b, "rho", "booms", 7850.0, lo=10.0, hi=1e5)
     if boom_tables:
         sc["boom"] = _check_booms(boom_tables, E, rho)
         L1, Lmin = sc["boom"][0]["length"], min(x["length"] for x in sc["boom"])
@@ -238,7 +239,8 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
         end = ls_hi if ls_hi != sc["booms"]["stroke0"] else ls_lo
     pl = raw.get("payload", {})
     check_keys(pl, {"mass"}, "payload")
-    sc["payload"] = {"mass": number(pl, "mass", "payload", 25000.0, lo=0.0)}
+    # the heaviest lifts of mobile cranes are ~1200 t
+    sc["payload"] = {"mass": number(pl, "mass", "payload", 25000.0, lo=0.0, hi=2e6)}
     r = raw.get("ropes", {})
     check_keys(r, {"EA"}, "ropes")
     sc["ropes"] = {"EA": number(r, "EA", "ropes", 1e8, lo=0.0, lo_open=True)}
@@ -401,6 +403,17 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
                              f"{sc['booms']['count']}: modal tables exist for booms.count "
                              f"{' or '.join(map(str, TABLE_BOOMS))} (allowed values; other counts: "
                              "model.reduction = 'none')")
+    if sc["model"]["reduction"] == "modal":
+        from sim_core.systems.telescopic.modal import allowed_ranges
+        (p_lo, p_hi), (a_lo, a_hi), _ = allowed_ranges(n_booms=sc["booms"]["count"])
+        if not p_lo <= sc["payload"]["mass"] <= p_hi:
+            raise SceneError(f"payload.mass = {sc['payload']['mass']!r}: out of range, allowed "
+                             f"[{p_lo:g}, {p_hi:g}] kg (the modal tables' payloads; "
+                             "model.reduction = 'none' takes any payload)")
+        if not a_lo <= sc["booms"]["luffing_angle_deg"] <= a_hi:
+            raise SceneError(f"booms.luffing_angle_deg = {sc['booms']['luffing_angle_deg']!r}: "
+                             f"out of range, allowed [{a_lo:g}, {a_hi:g}] (the modal tables' "
+                             "angles; model.reduction = 'none' takes 0..85)")
     if sc["model"]["reduction"] == "modal" and sc["effects"]["friction"]:
         raise SceneError("model.reduction = 'modal' with effects.friction = true: the modal tables "
                          "are frictionless; set effects.friction = false")
@@ -505,11 +518,11 @@ def _check_booms(tables: list, E0: float, rho0: float) -> list[dict]:
         check_keys(t, {"length", "E", "nu", "G", "rho", "section"}, w)
         if "nu" in t and "G" in t:
             raise SceneError(f"{w}.nu and {w}.G: give one of the two (G = E / (2 (1 + nu)))")
-        E = number(t, "E", w, E0, lo=0.0, lo_open=True)
+        E = number(t, "E", w, E0, lo=1e8, hi=1e15)
         nu = number(t, "nu", w, 0.3, lo=-1.0, hi=0.5, lo_open=True, hi_open=True)
         out.append({"length": number(t, "length", w, lo=0.0, lo_open=True), "E": E,
                     "G": number(t, "G", w, E / (2.0 * (1.0 + nu)), lo=0.0, lo_open=True),
-                    "rho": number(t, "rho", w, rho0, lo=0.0, lo_open=True),
+                    "rho": number(t, "rho", w, rho0, lo=10.0, hi=1e5),
                     "section": _check_section(table_of(t, "section", w), i)})
         c = out[-1]["section"]["constants"]
         if "mass_per_length" not in c:
