@@ -433,6 +433,57 @@ def _slew_signal(profile, i_phi: int):
     return LinearConstraint("slew", [{i_phi: 1.0}], part(0), part(1), part(2))
 
 
+#: points per boom of the replay geometry (the booms' centre lines at the output times)
+REPLAY_POINTS = 11
+
+
+def _replay_geometry(ts: TelescopicSystem, t, ys) -> dict:
+    """What a picture of the run needs, at every output time (global coordinates, m):
+
+    * ``geometry_centre_lines`` (n, N, REPLAY_POINTS, 3): each boom's reference line at equally
+      spaced material points from s = 0 to its length;
+    * ``geometry_section_frames`` (n, N, REPLAY_POINTS, 3, 3): the section frames there, rows
+      (e_t, e_b, e_s);
+    * ``geometry_luffing_cylinder`` (n, 2, 3): the cylinder's base D2 and head D3;
+    * ``geometry_contacts`` (n, N-1, 2, 3): each overlap's inner and outer contact points;
+    * ``geometry_section_outlines`` (N, k, 2): each boom's outer contour in section
+      coordinates (e_t, e_b), for drawing the booms as tubes."""
+    from sim_core.physics.beam.cardan import cardan_frame
+    m, p = ts.model, ts.params
+    n = m.n_dof
+    basis = m.beams[0].reference_basis
+    pts = [[material_point(m, k, s_fixed=float(s))
+            for s in np.linspace(0.0, p.lengths[k], REPLAY_POINTS)] for k in range(p.n_booms)]
+    cyl = next(c for c in m.nonlinear if c.name == "luffing_cylinder")
+    contacts = [(material_point(m, k, s_index=ts.s2_index[k]),
+                 material_point(m, k + 1, s_index=ts.s3_index[k + 1]))
+                for k in range(p.n_booms - 1)]
+    lines, frames, cylinder, cps = [], [], [], []
+    for tk, y in zip(t, ys):
+        Q, _ = m.full_state(tk, y[:n], y[n:])
+        rr, ff = [], []
+        for boom in pts:
+            ev = [pt(Q) for pt in boom]
+            rr.append([np.real(e[0]) for e in ev])
+            ff.append([np.real(cardan_frame(*e[2]) @ basis.T) for e in ev])
+        lines.append(rr)
+        frames.append(ff)
+        cylinder.append([np.real(pt(Q)[0]) for pt in reversed(cyl.points)])
+        cps.append([[np.real(a(Q)[0]), np.real(b(Q)[0])] for a, b in contacts])
+    outlines = []
+    for k in range(p.n_booms):                   # at most ~100 contour points a boom
+        o = np.asarray(ts.section_outline(k))
+        outlines.append(o[::max(1, int(math.ceil(len(o) / 96)))])
+    k_max = max(len(o) for o in outlines)
+    padded = np.full((p.n_booms, k_max, 2), np.nan)
+    for k, o in enumerate(outlines):
+        padded[k, :len(o)] = o
+    return {"geometry_centre_lines": np.array(lines), "geometry_section_frames": np.array(frames),
+            "geometry_luffing_cylinder": np.array(cylinder),
+            "geometry_contacts": np.array(cps).reshape(len(t), p.n_booms - 1, 2, 3),
+            "geometry_section_outlines": np.broadcast_to(padded, padded.shape).copy()}
+
+
 def _payload_outputs(ts: TelescopicSystem, t: float, Q, r_tip, out: dict) -> None:
     """payload_position (m), sway_angle (rad: from the vertical in the luffing plane and across
     it, the plane turned by the slew angle) and hoist_rope_force (N) at one output time."""
@@ -658,6 +709,7 @@ def _telescopic_result(ts: TelescopicSystem, t, ys, stats, error, scene=None):
     outputs = {k: np.array(v, dtype=float) for k, v in out.items()}
     # the integrated states at the output times (the energy check of the result re-evaluates
     # the energies from them, simulate.telescopic_energy_check)
+    outputs.update(_replay_geometry(ts, t, ys))
     outputs["state"] = np.asarray(ys, dtype=float)
     stats["n_dof"] = int(n)
     if m.uncompiled_effects:
