@@ -1,4 +1,4 @@
-"""Command line: ``boom-sim run|sweep|list|describe|plot``.
+"""Command line: ``boom-sim run|sweep|list|describe|plot|animate|export``.
 
 Errors in the scene (or an unreadable result file for ``plot``) exit with status 2 and a
 one-line message; a failed solve exits with status 3 and a one-line message (time and reason),
@@ -44,7 +44,7 @@ class _Progress:
             try:
                 from tqdm import tqdm
                 self.bar = tqdm(total=t_end, unit="s(sim)", bar_format=(
-                    "{l_bar}{bar}| {n:.3f}/{total:.3f} s sim [{elapsed} wall, {postfix}]"),
+                    "{l_bar}{bar}| {n:.3f}/{total:.3f} s sim [{elapsed} wall{postfix}]"),
                     file=sys.stderr)
             except ImportError:  # pragma: no cover
                 self.bar = None
@@ -85,6 +85,8 @@ def cmd_run(args) -> int:
     summary = {"scene": scene["name"], **result.stats}
     atomic_write_bytes(out / "summary.json", json.dumps(summary, indent=2, default=str).encode())
     figs = [] if args.no_plots else _plots(result, out)
+    if args.animate:
+        figs.append(_animate(result, out / "anim.gif"))
     st = result.stats
     wall = float(st.get("wall_time_s", 0.0))
     rtf = st.get("real_time_factor", scene["solver"]["t_end"] / max(wall, 1e-12))
@@ -124,6 +126,45 @@ def _save_failure(scene: dict, out: Path, exc: SimulationError) -> str:
         return f"; no partial result (summary.json written to {out})"
     t_last = float(partial.t[-1]) if len(partial.t) else 0.0
     return f"; partial result up to t = {t_last:.6g} s written to {out / 'result.npz'}"
+
+
+def _load_result(path) -> Result:
+    try:
+        return Result.load(path)
+    except (OSError, ValueError, KeyError) as exc:
+        raise _InputError(f"cannot read result file {str(path)!r}: {_one_line(exc)}") from None
+
+
+def _animate(result: Result, out: Path, **kw) -> Path:
+    """The run's animation (sim_core.animation); a result without replay geometry is an input
+    error naming why."""
+    from sim_core.animation import animate
+    try:
+        return animate(result, out, **kw)
+    except (ValueError, ImportError) as exc:
+        raise _InputError(f"cannot animate: {_one_line(exc)}") from None
+
+
+def cmd_animate(args) -> int:
+    res = _load_result(args.result)
+    kw = {"scale": args.scale, "speed": args.speed, "fps": args.fps, "t_start": args.t_start,
+          "t_end": args.t_end, "view": args.view}
+    if args.overlay:
+        kw["overlays"] = tuple(args.overlay)
+    path = _animate(res, Path(args.out), **kw)
+    print(f"wrote {path}")
+    return 0
+
+
+def cmd_export(args) -> int:
+    from sim_core.vtk_export import export_vtk
+    res = _load_result(args.result)
+    try:
+        pvd = export_vtk(res, Path(args.vtk))
+    except (ValueError, OSError) as exc:
+        raise _InputError(f"cannot export: {_one_line(exc)}") from None
+    print(f"wrote {pvd} ({len(res.t)} time steps; open it in ParaView)")
+    return 0
 
 
 def _plots(result: Result, out: Path) -> list:
@@ -168,10 +209,7 @@ def cmd_describe(args) -> int:
 
 
 def cmd_plot(args) -> int:
-    try:
-        res = Result.load(args.result)
-    except (OSError, ValueError, KeyError) as exc:
-        raise _InputError(f"cannot read result file {args.result!r}: {_one_line(exc)}") from None
+    res = _load_result(args.result)
     out = Path(args.out) if args.out else Path(args.result).parent
     try:
         import matplotlib  # noqa: F401
@@ -250,6 +288,8 @@ def main(argv: list[str] | None = None) -> int:
     r.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scene value")
     r.add_argument("--quiet", action="store_true", help="no progress bar")
     r.add_argument("--no-plots", action="store_true")
+    r.add_argument("--animate", action="store_true",
+                   help="also write anim.gif, the crane in motion (telescopic full model)")
     r.set_defaults(func=cmd_run)
     sw = sub.add_parser("sweep", help="run the Cartesian product of scene overrides as Ray tasks",
                         description=_SWEEP_HELP, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -281,9 +321,35 @@ def main(argv: list[str] | None = None) -> int:
     pl.add_argument("result")
     pl.add_argument("--out", default=None)
     pl.set_defaults(func=cmd_plot)
+    an = sub.add_parser("animate", help="an animation of a result (GIF or MP4)")
+    an.add_argument("result")
+    an.add_argument("--out", default="anim.gif", help="anim.gif or anim.mp4 (default anim.gif)")
+    an.add_argument("--scale", type=float, default=1.0,
+                    help="deflection exaggeration (1: the true shape)")
+    an.add_argument("--speed", type=float, default=1.0, help="playback speed (1: real time)")
+    an.add_argument("--fps", type=int, default=20, help="frames per second")
+    an.add_argument("--t-start", type=float, default=None, help="window start, s")
+    an.add_argument("--t-end", type=float, default=None, help="window end, s")
+    an.add_argument("--view", choices=("3d", "two"), default="3d",
+                    help="a 3-D view or a side and a top view")
+    an.add_argument("--overlay", action="append", metavar="OUTPUT",
+                    help="an output shown with its value (repeat; default: stroke and "
+                         "telescopic cylinder force)")
+    an.set_defaults(func=cmd_animate)
+    ex = sub.add_parser("export", help="a result as a ParaView time series")
+    ex.add_argument("result")
+    ex.add_argument("--vtk", required=True, metavar="DIR",
+                    help="folder for result.pvd and one .vtu per output time")
+    ex.set_defaults(func=cmd_export)
     args = p.parse_args(argv)
     try:
         return args.func(args)
+    except BrokenPipeError:
+        # the reader of the output went away (``boom-sim describe ... | head``): not an error;
+        # stdout goes to /dev/null so that the interpreter's final flush stays quiet
+        import os
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
     except SceneError as exc:
         print(f"boom-sim: scene error: {_one_line(exc)}", file=sys.stderr)
         return 2
