@@ -35,7 +35,7 @@ import scipy.linalg as sla
 from sim_core.physics._constraints_numba import program_for
 from sim_core.physics._rigid_body_numba import joint_program_for
 from sim_core.physics.complex_step import COMPLEX_STEP
-from sim_core.physics.constraints import constraint_terms, targets
+from sim_core.physics.constraints import _partition, constraint_terms, targets
 
 REL_STEP = 1.5e-8                # ~sqrt(machine epsilon): forward-difference step per unit of |x|
 # the constraint pieces' columns in one compiled sweep (sim_core.physics._constraints_numba) where the
@@ -234,9 +234,28 @@ def residual_derivatives(model, t: float, Q: np.ndarray, Qd: np.ndarray, Qdd: np
             dR2[:, cols] += weight * d2
         _, G, _, G_rate = prog.terms(Q, Qd, rate_part=True)     # d/dQ_dot as below
         dR2[:, N:] += 2.0 * G_rate + 2.0 * xi1 * G
-    for c in ([] if prog is not None else model.nonlinear):
+    # where no program covers every row (a turntable's joints beside the booms' contact rows):
+    # the rows a compiled program covers in its sweep, the others as pieces below
+    part = (_partition(model.nonlinear) if prog is None and COMPILED_CONSTRAINT_COLUMNS
+            and model.nonlinear else None)
+    python_rows = model.nonlinear if prog is None else []
+    if part is not None:
+        pc, comp, r_comp, python_rows, _, _ = part
+        b0, bd, bdd = targets(comp, t)
+        deps = pc.dependencies(Q)
+        cols = np.flatnonzero(deps.any(axis=0))
+        for sign in signs:
+            d1, d2 = pc.columns(Q, Qd, Qdd, lam[r_comp], b0, bd, bdd, xi1, xi2, cols,
+                                signed_steps(sign)(Q[cols]), deps)
+            dR1[:, cols] += weight * d1
+            dR2[np.ix_(r_comp, cols)] += weight * d2
+        _, Gc, _, Gc_rate = pc.terms(Q, Qd, rate_part=True)
+        dR2[r_comp, N:] += 2.0 * Gc_rate + 2.0 * xi1 * Gc
+    starts = np.cumsum([0] + [c.m for c in model.nonlinear])
+    first = {id(c): int(starts[k]) for k, c in enumerate(model.nonlinear)}
+    for c in python_rows:
+        row = first[id(c)]
         sl = slice(row, row + c.m)
-        row += c.m
         b0, bd, bdd = c.b(t)
 
         def constraint(Qx, Qdx, c=c, lam_c=lam[sl], b0=b0, bd=bd, bdd=bdd):

@@ -52,6 +52,7 @@ class HangingMass:
     mass: float
     gravity: np.ndarray | None = None
     name: str = "payload"
+    time_invariant = True                    # local() does not depend on t
 
     def coords(self, Q):
         return np.arange(self.index, self.index + 3)
@@ -87,6 +88,7 @@ class HoistRope:
     length: Callable
     slack_width: float = 1e-6
     name: str = "hoist_rope"
+    takes_time = True                        # local(t, ...) reads L0(t): callers pass t
 
     @property
     def points(self):

@@ -221,14 +221,17 @@ class CompiledPointEffects:
     def build(effects) -> "CompiledPointEffects | None":
         """The compiled program of the payloads and ropes among ``effects``; time-invariant
         effects of other kinds with a ``local`` form (:class:`SliderSeat`) are evaluated in
-        Python beside it (``uncompiled``).  None where no payload or rope is there, or an
-        effect of another kind is not time-invariant."""
+        Python beside it (``uncompiled``), and so are effects that read the time their
+        ``local`` is given (``takes_time``: the hoist rope of a prescribed length; every caller
+        passes t).  None where no payload or rope is there, or an effect of another kind is
+        neither."""
         from sim_core.physics._constraints_numba import DIFF_R, ROPE, program_for
         from sim_core.physics.constraints import NonlinearConstraint
         compiled = [pe for pe in effects if type(pe) in (PointMass, RopeDrive)]
         other = [pe for pe in effects if type(pe) not in (PointMass, RopeDrive)]
-        if not compiled or not all(getattr(pe, "time_invariant", False) and hasattr(pe, "local")
-                                   for pe in other):
+        if not compiled or not all((getattr(pe, "time_invariant", False)
+                                    or getattr(pe, "takes_time", False))
+                                   and hasattr(pe, "local") for pe in other):
             return None
         order = compiled_order(effects, (PointMass, RopeDrive))
         cons, rows, row = [], [], 0
