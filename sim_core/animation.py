@@ -46,13 +46,11 @@ atomically (rendered to a temporary file in the same folder, then renamed).
 from __future__ import annotations
 
 import math
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
-from sim_core.result import _fsync_dir, _mode_for
+from sim_core.result import atomic_path
 
 __all__ = ["ALLOWED_SUFFIXES", "animate", "frame_times"]
 
@@ -123,25 +121,14 @@ def animate(result, out, *, scale=1.0, speed=1.0, fps=20, t_start=None, t_end=No
         matplotlib.rcParams["animation.ffmpeg_path"] = ffmpeg
         writer = mpl_animation.FFMpegWriter(fps=fps, codec="h264")
 
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=out.parent, prefix=f".{out.stem}.", suffix=suffix)
-    os.close(fd)
     try:
-        with writer.saving(renderer.fig, tmp, dpi=_DPI):
-            for tq in times:
-                renderer.update(tq)
-                writer.grab_frame()
-        with open(tmp, "rb+") as f:       # the content on disk before the rename
-            os.fsync(f.fileno())
-        os.chmod(tmp, _mode_for(out))
-        os.replace(tmp, out)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+        with atomic_path(out, suffix=suffix) as tmp:    # written atomically (sim_core.result)
+            with writer.saving(renderer.fig, tmp, dpi=_DPI):
+                for tq in times:
+                    renderer.update(tq)
+                    writer.grab_frame()
     finally:
         renderer.close()
-    _fsync_dir(out.parent)
     return out
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import tempfile
@@ -21,13 +22,23 @@ def atomic_write_bytes(path: str | Path, data: bytes) -> None:
     is removed and an existing ``path`` is left untouched.  The new file gets the usual
     permissions (those of the file it replaces, else 0666 less the umask), not mkstemp's 0600.
     """
+    with atomic_path(path) as tmp, os.fdopen(os.open(tmp, os.O_WRONLY | os.O_TRUNC), "wb") as f:
+        f.write(data)
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | Path, suffix: str = ".tmp"):
+    """A temporary file path beside ``path`` for a writer that needs a path (an animation, an
+    archive); when the block ends without an error the file is flushed to disk and renamed to
+    ``path`` in one step (os.replace), with the folder's entry synced; on an error it is
+    removed and ``path`` keeps what it held."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=suffix)
+    os.close(fd)
     try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-            f.flush()
+        yield tmp
+        with open(tmp, "rb+") as f:       # the content on disk before the rename
             os.fsync(f.fileno())
         os.chmod(tmp, _mode_for(path))
         os.replace(tmp, path)
