@@ -304,14 +304,19 @@ def test_properties_section_refuses_slider_springs():
 @pytest.mark.slow
 def test_crane_hexagonal_4_full_extraction():
     """The shipped user crane through its whole 20 s extraction: every stage reaches its
-    6 m stroke (the cubic schedule's v_max (t_hold_end + t_ramp ... ) travel, 1 -> 7 m), the
+    6 m stroke (the cubic schedule's travel v_max t_hold_end, 1 -> 7 m), the
     run passes its own checks (constraint violation and energy balance, Result.suspect), and
     the slider springs of every region carry load at the end (the sections rest on their
     sliders: a compressed spring in every region)."""
     res = simulate(load_scene("crane_hexagonal_4"))
     assert not res.suspect, res.failed_checks
     assert res.t[-1] == pytest.approx(20.0)
-    np.testing.assert_allclose(res["stage_stroke"][-1], 6.0, atol=1e-6)
+    # the cylinders' stages (1-2 and 3-4) to the constraint's drift; the rope unit's stage
+    # (2-3) to the change of the ropes' stretch, below their static stretch T L / EA
+    # ~ 80 kN x 20 m / 1e8 N = 16 mm
+    stroke = res["stage_stroke"][-1]
+    np.testing.assert_allclose(stroke[[0, 2]], 6.0, atol=1e-6)
+    assert stroke[1] == pytest.approx(6.0, abs=0.02)
     sf = res["slider_contact_forces"][-1]                 # (regions, springs), N
     assert sf.shape[0] == 6
     assert np.all(np.nanmax(sf, axis=1) > 0.0)
