@@ -73,6 +73,11 @@ class Case:
         return self.moment_model == DEFAULT[0] and self.friction_load in (None, DEFAULT[1])
 
 
+def _cell(text: str) -> str:
+    """A markdown table cell's text with its "|" escaped."""
+    return str(text).replace("|", "\\|")
+
+
 def cases() -> list[Case]:
     out = []
     for scene in ("telescopic_extraction", "telescopic_retraction"):
@@ -503,8 +508,11 @@ def report(results: dict, img: Path, report_path: Path, quick: bool,
             f"{c.label}{' (default)' if c.is_default else ''}" for c, _ in chosen) + " |"
         lines += [header, "|" + "---|" * (2 + len(chosen))]
         for i, row in enumerate(base):
-            cells = [f"{table[c][i].value}: {mark(table[c][i].holds)}" for c, _ in chosen]
-            lines.append(f"| {row.figure} | {row.statement} | " + " | ".join(cells) + " |")
+            # a "|" inside a cell (|r - r_rigid|) is escaped, or it would split the cell
+            cells = [_cell(f"{table[c][i].value}: {mark(table[c][i].holds)}")
+                     for c, _ in chosen]
+            lines.append(f"| {row.figure} | {_cell(row.statement)} | " + " | ".join(cells)
+                         + " |")
         lines += ["", f"Wall times as the runs recorded them ({machine}); speed figures are on "
                   "the [performance](performance.md) page.", "",
                   "| model | wall time (s) | steps | status |", "|---|---|---|---|"]
