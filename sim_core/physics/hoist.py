@@ -23,7 +23,7 @@ from typing import Callable
 
 import numpy as np
 
-from sim_core.physics.point_effects import path_length
+from sim_core.physics.point_effects import path_length, ramp_energy, ramp_tension
 
 __all__ = ["free_point", "HangingMass", "HoistRope"]
 
@@ -108,6 +108,56 @@ class HoistRope:
     def tension(self, ell: float, t: float) -> float:
         """T (N) at span ell (m) and time t: tension-only with a C1 ramp over slack_width."""
         L0 = self.length(t)[0]
+        return ramp_tension(self.EA / L0, ell - L0, self.slack_width)
+
+    def local(self, t, Q, Qd, mass=True):
+        f = np.zeros(3) if self.gravity is None else self.mass * np.asarray(self.gravity, float)
+        return self.coords(Q), (self.mass * np.eye(3) if mass else None), f
+
+    def add(self, t, Q, Qd, M, F):
+        idx, Me, Fe = self.local(t, Q, Qd, M is not None)
+        F[idx] += Fe
+        if M is not None:
+            M[np.ix_(idx, idx)] += Me
+
+    def energy(self, Q, Qd) -> float:
+        """Kinetic and gravity energy, J (zero height at Z = 0)."""
+        r, v = Q[self.index:self.index + 3], Qd[self.index:self.index + 3]
+        g = np.zeros(3) if self.gravity is None else np.asarray(self.gravity, float)
+        return float(np.real(0.5 * self.mass * (v @ v) - self.mass * (r @ g)))
+
+
+@dataclass
+class HoistRope:
+    """The hoist rope from the boom tip ``top`` to the payload ``bottom`` (point functions),
+    axial stiffness EA (N), unstretched length ``length(t)`` -> (L0, L0_dot, L0_ddot) (m)."""
+
+    top: Callable
+    bottom: Callable
+    EA: float
+    length: Callable
+    slack_width: float = 1e-6
+    name: str = "hoist_rope"
+    takes_time = True                        # local(t, ...) reads L0(t): callers pass t
+
+    @property
+    def points(self):
+        return (self.top, self.bottom)
+
+    def coords(self, Q):
+        from sim_core.physics.constraints import dependencies
+        return dependencies(self.points, Q)
+
+    def velocity_coords(self, Q):
+        return np.zeros(0, dtype=int)
+
+    def span(self, Q):
+        """(l, dl/dQ): the distance tip-payload, m, and its gradient."""
+        return path_length(self.points, Q)
+
+    def tension(self, ell: float, t: float) -> float:
+        """T (N) at span ell (m) and time t: tension-only with a C1 ramp over slack_width."""
+        L0 = self.length(t)[0]
         k = self.EA / L0
         x = (ell - L0) / self.slack_width
         if x <= 0:
@@ -129,8 +179,8 @@ class HoistRope:
     def energy(self, Q, t: float) -> float:
         """Strain energy U (J): the integral of the tension over the span from slack."""
         ell = float(np.real(self.span(Q)[0]))
-        return _strain_energy(self.EA / self.length(t)[0], ell - self.length(t)[0],
-                              self.slack_width)
+        L0 = self.length(t)[0]
+        return float(ramp_energy(self.EA / L0, ell - L0, self.slack_width))
 
     def hoist_power(self, Q, t: float) -> float:
         """dU/dL0 * L0_dot (W): the power the hoist feeds into the rope while it changes the
@@ -141,16 +191,4 @@ class HoistRope:
         ell = float(np.real(self.span(Q)[0]))
         h = 1e-20 * L0
         L = L0 + 1j * h
-        dU = _strain_energy(self.EA / L, ell - L, self.slack_width, complex_ok=True).imag / h
-        return float(dU * L0d)
-
-
-def _strain_energy(k, stretch, s, complex_ok: bool = False):
-    """int_0^stretch of the ramped tension k ramp(x) dx (J) for stiffness k (N/m)."""
-    x = np.real(stretch) / s
-    if x <= 0:
-        return 0.0 * k
-    if x >= 1:
-        # int_0^s k x^2/(2 s) dx + int_s^e k (x - s/2) dx
-        return k * s * s / 6 + k * ((stretch - s / 2) ** 2 - (s / 2) ** 2) / 2
-    return k * stretch ** 3 / (6 * s)
+        return float(np.imag(ramp_energy(self.EA / L, ell - L, self.slack_width)) / h * L0d)

@@ -50,6 +50,28 @@ class PointMass:
         _add_local(self.local(t, Q, Qd, M is not None), M, F)
 
 
+def ramp_tension(k, d, w):
+    """Tension (N) of a tension-only rope of stiffness k (N/m) stretched by d (m), with a C1
+    ramp over the first w (m): 0 when slack, k d^2 / (2 w) on the ramp, k (d - w/2) beyond."""
+    x = d / w
+    if x <= 0:
+        return 0.0
+    if x >= 1:
+        return k * (d - 0.5 * w)
+    return k * w * 0.5 * x * x
+
+
+def ramp_energy(k, d, w):
+    """Strain energy (J) of :func:`ramp_tension`: its integral over the stretch from slack
+    (complex-step safe in k and d: the branches follow their real parts)."""
+    dr = np.real(d)
+    if dr <= 0.0:
+        return 0.0 * k
+    if dr <= np.real(w):
+        return k * d ** 3 / (6.0 * w)
+    return k * w * w / 6.0 + k * (0.5 * (d * d - w * w) - 0.5 * w * (d - w))
+
+
 def path_length(points, Q):
     """(l, dl/dQ): the length (m) of the polyline through the points' positions at Q and its
     gradient (complex-step safe)."""
@@ -94,12 +116,7 @@ class RopeDrive:
         k = self.EA / self.L0
         if self.bilateral:
             return k * (ell - self.L0)
-        x = (ell - self.L0) / self.slack_width
-        if x <= 0:
-            return 0.0
-        if x >= 1:
-            return k * (ell - self.L0 - 0.5 * self.slack_width)
-        return k * self.slack_width * 0.5 * x * x
+        return ramp_tension(k, ell - self.L0, self.slack_width)
 
     def tension_rate(self, ell):
         """dT/dl (N/m) of :meth:`tension`."""

@@ -107,7 +107,8 @@ def _section_outline(ts: "TelescopicSystem", k: int) -> np.ndarray:
     if p.booms is not None:
         return p.booms[k].section.outer
     from sim_core.systems.telescopic.params import _Y_A, _WALL, family_radius
-    r = (0.09, 0.07, 0.05)[k] if p.n_booms <= 3 else family_radius(k, p.n_booms)
+    # two shorthand booms are the paper's booms 1 and 2 (params.crane_sections)
+    r = family_radius(k, max(p.n_booms, 3))
     return cross_section({"shape": "u", "top_arc_centre_y": _Y_A, "top_arc_centre_z": _Y_A,
                           "top_arc_radius": r, "wall": _WALL}, method="closed form").outer
 

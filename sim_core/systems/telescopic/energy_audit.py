@@ -37,7 +37,7 @@ import numpy as np
 from sim_core.integrate.checks import ENERGY_FAIL, ENERGY_SUSPECT, verdict
 from sim_core.physics.constraints import constraint_terms
 from sim_core.physics.hoist import HangingMass, HoistRope
-from sim_core.physics.point_effects import RopeDrive, SliderSeat
+from sim_core.physics.point_effects import RopeDrive, SliderSeat, ramp_energy
 from sim_core.result import Result
 
 WORK_NAMES = ("constraint_work", "drive_work", "friction_work", "filter_work")
@@ -46,13 +46,7 @@ WORK_NAMES = ("constraint_work", "drive_work", "friction_work", "filter_work")
 def rope_energy(rope: RopeDrive, ell: float) -> float:
     """Strain energy (J) of a tension-only RopeDrive at length ell (m): the integral of its
     C1-ramp tension law (point_effects.RopeDrive.tension)."""
-    w, k = rope.slack_width, rope.EA / rope.L0
-    d = ell - rope.L0
-    if d <= 0.0:
-        return 0.0
-    if d <= w:
-        return k * d ** 3 / (6.0 * w)
-    return k * w * w / 6.0 + k * (0.5 * (d * d - w * w) - 0.5 * w * (d - w))
+    return float(ramp_energy(rope.EA / rope.L0, ell - rope.L0, rope.slack_width))
 
 
 def mechanical_energy(ts, t: float, z: np.ndarray, zd: np.ndarray) -> float:

@@ -616,7 +616,7 @@ def _check_luffing(t: dict, booms: dict, L_h: float, L1: float) -> dict:
         raise SceneError(f"luffing.head_on_boom[0] = {s3:g} m: out of range, allowed (0, {L1:g}) "
                          "m (on boom 1, whose length is the upper bound)")
     from sim_core.systems.telescopic.luffing import luffing_geometry
-    spec = LuffingSpec(**{k: tuple(v) for k, v in out.items()})
+    spec = _luffing_spec({"luffing": out})
     theta = math.radians(booms.get("luffing_angle_deg", 60.0))
     geo = luffing_geometry(theta, *spec.points())
     if geo.cylinder_length < 0.1 or geo.lever < 0.01:
@@ -729,9 +729,7 @@ def params_from_scene(sc: dict):
                                      o["outer_slider_distance"], o["radial_gap"],
                                      None if o["bears_on"] is None else tuple(o["bears_on"]))
                          for o in sc["overlap"])
-    luffing = None
-    if sc.get("luffing"):
-        luffing = LuffingSpec(**{k: tuple(v) for k, v in sc["luffing"].items()})
+    luffing = _luffing_spec(sc) if sc.get("luffing") else None
     src = sc.get("source")
     legacy = d.get("profile", "cubic") == "cubic" and "t_start" not in d
     profiles = {"drive_profile": None if legacy else
