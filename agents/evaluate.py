@@ -88,15 +88,15 @@ def telescopic_force(env, a: float) -> float:
 
     F = m2 (a + g sin th) + 2 T_e with T_e = (m3 + m_p)(2 a + g sin th): the rigid-boom force of
     the inextensible rope drive (boom 3 moves twice the stroke, Zhao-Qi-Wang 2024 Eqs. 74-76;
-    ``sim_core.systems.telescopic.rigid``), plus the elastic part Gamma . q'' of the modal coordinates:
+    the boom masses of sim_core.rom.boom_masses), plus the elastic part Gamma . q'' of the modal
+    coordinates:
     the kinetic energy of Q = Q_s(L_s) + Phi q has the cross term L_s' Gamma . q' (Gamma = Phi^T M
     dQ_s/dL_s, mass-normalised modes), whose Lagrange term along L_s is Gamma . q''.  The ROM is
     frictionless and drops the slow d Gamma/dt terms."""
-    from sim_core.systems.telescopic.params import TelescopicParams, boom_section
+    from sim_core.rom import boom_masses
     u = env.unwrapped
     if not hasattr(u, "_masses"):
-        p = TelescopicParams()
-        u._masses = [boom_section(k, p).rhoA * p.boom_length for k in range(3)]
+        u._masses = list(boom_masses(3))
     m2, m3 = u._masses[1], u._masses[2]
     gs = 9.81 * math.sin(math.radians(u.angle))
     F_rigid = m2 * (a + gs) + 2.0 * (m3 + u.payload) * (2.0 * a + gs)
@@ -142,7 +142,7 @@ def _settle_time(t: np.ndarray, ok: np.ndarray) -> float | None:
 
 
 def metrics(tr: Trace) -> dict:
-    """The issue's metrics of one episode (see the module docstring)."""
+    """The evaluation metrics of one episode (see the module docstring)."""
     err = np.abs(tr.stroke - tr.target)
     t_target = _settle_time(tr.t, err <= STROKE_TOL)
     t_stop = _settle_time(tr.t, (err <= STROKE_TOL) & (np.abs(tr.rate) <= SPEED_TOL))

@@ -10,15 +10,15 @@ Schedules (all extract 2 -> 8 m, i.e. travel 6 m; times in s):
 
 * ``cubic``: the paper's schedule (Zhao-Qi-Wang 2024 Sec. 9, docs/model.md#input-drive):
   smoothstep ramp 0 -> 0.5 m/s in 4 s, hold to 12 s, mirrored ramp-down to rest at 16 s
-  (``sim_core.physics.drive_profiles.CubicSmoothstepSchedule``).
+  (``sim_core.profiles.CubicSmoothstepSchedule``).
 * ``trapezoid``: the same duration (16 s), top speed and travel with constant accelerations:
   V (D - t_a) = travel gives t_a = 4 s, a = +-0.125 m/s^2.
 * ``zv_trapezoid``: a zero-vibration (ZV) input shaper (Singer & Seering 1990) applied to a
   shorter trapezoid so that the shaped command has the same 16 s duration: the base command is
   convolved with two impulses A_1 = 1 / (1 + K), A_2 = K / (1 + K) at 0 and T_d / 2,
   K = exp(-zeta pi / sqrt(1 - zeta^2)), T_d = 2 pi / omega_d, tuned to the first in-plane
-  bending mode of the full sim_core model at the *target* stroke (``sim_core.systems.telescopic.modal``
-  tables: 0.43 Hz, zeta 0.7 % at L_s = 8 m with 25 t).  The residual vibration after the stop is
+  bending mode of the full sim_core model at the *target* stroke (the modal tables,
+  ``sim_core.rom``: 0.43 Hz, zeta 0.7 % at L_s = 8 m with 25 t).  The residual vibration after the stop is
   the response of the mode at the end of the motion, so that is the frequency to cancel.
 """
 
@@ -30,7 +30,7 @@ from typing import Callable
 
 import numpy as np
 
-from sim_core.physics.drive_profiles import CubicSmoothstepSchedule
+from sim_core.profiles import CubicSmoothstepSchedule
 
 V_MAX = 0.5          # m/s, docs/model.md#input-drive
 DURATION = 16.0      # s, end of the paper's cubic schedule
@@ -92,8 +92,8 @@ def zv_impulses(omega: float, zeta: float) -> tuple[np.ndarray, np.ndarray]:
 
 def first_mode(payload: float = 25000.0, angle_deg: float = 60.0, stroke: float = 8.0):
     """(omega rad/s, zeta) of the first in-plane mode of the full model at piston length
-    ``stroke`` (m), from the modal tables of sim_core.systems.telescopic.modal."""
-    from sim_core.systems.telescopic.modal import tables_for
+    ``stroke`` (m), from the modal tables (sim_core.rom)."""
+    from sim_core.rom import tables_for
     c = tables_for(payload, angle_deg, 1).coefficients(stroke)
     return float(c[0, 0]), float(c[1, 0])
 

@@ -9,7 +9,7 @@ acceleration plus a critically damped tracking feedback on the schedule's stroke
 0.25 a_max times the policy output, so the untrained policy (output ~0) is the cubic schedule
 and PPO learns the correction that lowers the tip vibration (residual policy learning, Silver
 et al. 2018; Johannink et al. 2019).  ``--residual none`` trains the acceleration from scratch
-(the first approach; it did not reach the target in 400k steps, agents/README.md).
+(it did not reach the target in 400k steps with the shipped hyper-parameters).
 
 Stable-Baselines3 PPO with an MLP policy, observation and reward normalisation (VecNormalize),
 a SubprocVecEnv with one env process per available core (``--vec dummy`` runs them in-process,
@@ -418,7 +418,7 @@ def main(argv=None) -> int:
     ap.add_argument("--obs-offset", type=float, default=0.0,
                     help="random constant offset (m) of the observed tip deflection per "
                          "episode, drawn from [-X, X] (agents.wrappers.DeflectionOffset; "
-                         "default 0: no offsets; the variant in agents/README.md uses 0.005)")
+                         "default 0: no offsets; e.g. 0.005)")
     ap.add_argument("--env-set", action="append", default=[], metavar="KEY=VALUE",
                     help="training-env constructor argument (replaces the defaults "
                          f"{TRAIN_ENV_KWARGS}); repeatable")

@@ -21,7 +21,7 @@ h = 0.01 s; ``TelescopicParams(n_booms=N, n_nodes=n_sub + 1)``), from the static
 Wall time (``time.perf_counter``), not process time: the element worker thread, where a second
 core is free, waits actively between requests, and process time would count that.  With the
 filter on, RK45 is stability-limited (step ~ 1.3 h: the filter mass (h^2/6) K caps the highest
-frequency near sqrt(6)/h; second seed Eq. 53), so steps per simulated second hardly depend on
+frequency near sqrt(6)/h; SIMULTECH 2020 Eq. 53), so steps per simulated second hardly depend on
 the mesh or the number of booms and the growth is that of one RHS.
 
 Fitted exponent p of cost ~ x^p: least squares of log(cost) on log(x).

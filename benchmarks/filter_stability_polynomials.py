@@ -6,7 +6,7 @@ One command (from the repository root; a design calculation, no timing):
 
     python benchmarks/filter_stability_polynomials.py
 
-The filter of the second seed (Eq. 53; ``StressFilter``: (h_f^2/6) K added to the mass,
+The filter of the SIMULTECH 2020 paper (Eq. 53; ``StressFilter``: (h_f^2/6) K added to the mass,
 (h_f/2) K to the damping) moves a mode of undamped angular frequency w to the roots of
 
     (1 + h_f^2 w^2 / 6) lambda^2 + (h_f w^2 / 2) lambda + w^2 = 0,

@@ -1,4 +1,4 @@
-"""Tip velocity of the folding boom for several stress-filter windows h (second seed: the paper
+"""Tip velocity of the folding boom for several stress-filter windows h (SIMULTECH 2020: the paper
 compares h = 0, 0.001, 0.002, 0.005 s; h = 0 is not run: without the filter the axial modes
 force RK45 to ~1e-6 s steps).
 

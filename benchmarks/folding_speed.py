@@ -1,4 +1,4 @@
-"""What the folding long-boom scene (`folding_boom`, second seed) costs: one right-hand side,
+"""What the folding long-boom scene (`folding_boom`, SIMULTECH 2020) costs: one right-hand side,
 a short window of the scene and, with ``--full``, the whole 45 s.
 
 One command (from the repository root, pinned to one core):

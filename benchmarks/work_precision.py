@@ -20,7 +20,7 @@ simulated second).  ``--part beam`` / ``--part telescopic`` runs one part only.
     midspan deflection error (m) against Fryba's series (sim_core.validation.closed_form,
     Fryba 1972 Ch. 1, 31 terms) AND against a converged reference (quick: 8 sub-elements,
     RK45 rtol 1e-7, filter h = 0.3 ms; full: 16 sub-elements, rtol 1e-9, h = 0.1 ms; the
-    unfiltered model is too stiff for a reference in reasonable time, see docs/performance.md).  Sweeps: sub-elements (2, 4, 8, 16), rtol, filter h (second seed
+    unfiltered model is too stiff for a reference in reasonable time, see docs/performance.md).  Sweeps: sub-elements (2, 4, 8, 16), rtol, filter h (SIMULTECH 2020
     Eq. 53), integrator (RK45 on model.rhs; generalized-alpha rho_inf = 0.8 adaptive and scipy
     Radau, both on Model.mass_and_force with finite-difference tangents).
 (b) Telescopic extraction (Zhao-Qi-Wang 2024 Sec. 9), window [0, T] from the static
@@ -177,7 +177,7 @@ def part_beam(quick: bool, out_rows: list):
           f"peak midspan {peak * 1e3:.3f} mm", flush=True)
     # Without the stress filter the axial / high bending modes of the quintic splines make
     # RK45 stability-limited (h ~ 1e-5 s) and the implicit error test resolve them: the filter
-    # (h^2/6) K mass caps the highest frequency near sqrt(6)/h (second seed, Eq. 53), so the
+    # (h^2/6) K mass caps the highest frequency near sqrt(6)/h (SIMULTECH 2020, Eq. 53), so the
     # reference is a small-h filtered run; its filter error shows in the h sweep.
     BUDGET[0] = 120.0 if quick else 1200.0
     ref_n, ref_h, ref_r = (8, 3e-4, 1e-7) if quick else (16, 1e-4, 1e-9)

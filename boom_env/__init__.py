@@ -24,4 +24,14 @@ for _id, _task in (("boom_env/TelescopicExtraction-v0", "extraction"),
                  max_episode_steps=MAX_EPISODE_STEPS,
                  kwargs={"task": _task, "dt": DT, "t_max": T_MAX})
 
+# v1: the payload swings on its hoist rope (boom_env.telescopic_sway_env); gym.make_vec makes the
+# native vector env (boom_env.vector_env) by default
+for _id, _task in (("boom_env/TelescopicExtraction-v1", "extraction"),
+                   ("boom_env/TelescopicRetraction-v1", "retraction")):
+    if _id not in registry:
+        register(id=_id, entry_point="boom_env.telescopic_sway_env:TelescopicSwayEnv",
+                 vector_entry_point="boom_env.vector_env:TelescopicSwayVectorEnv",
+                 max_episode_steps=MAX_EPISODE_STEPS,
+                 kwargs={"task": _task, "dt": DT, "t_max": T_MAX})
+
 __all__ = ["TelescopicBoomEnv", "MAX_EPISODE_STEPS"]

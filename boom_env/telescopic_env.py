@@ -9,34 +9,48 @@ Boom count (``booms``)
 ----------------------
 * ``3`` (default): the paper's crane; the tip moves 2 m per m of L_s.
 * ``5``: five sections, the paper's three booms inside two larger ones of the same family
-  (``sim_core.systems.telescopic.params.crane_sections``; scenes ``telescopic_extraction_5`` /
+  (the U family of the paper's Table 2; scenes ``telescopic_extraction_5`` /
   ``telescopic_retraction_5``), synchronized drive: cylinders on stages 1-2 and 3-4 and rope
   units moving booms 3 and 5, every stage moving with the same L_s, so the tip moves 4 m per m
   of L_s (up to 2 m/s at v_max = 0.5 m/s) and the boom is 17-43 m long.  Payload 5-15 t
   (default 10 t); first in-plane bending mode 0.24-1.77 Hz over the tables (0.615 Hz at
   L_s = 5 m, 10 t, 60 deg; three booms at 25 t: 0.71 Hz).
 Other counts raise ValueError: modal tables are shipped for 3 and 5 sections
-(``sim_core.systems.telescopic.modal.TABLE_BOOMS``).  The spaces and the reward's form are the
+(``sim_core.rom.TABLE_BOOMS``).  The spaces and the reward's form are the
 same for both; the plant, the default payload, the payload range and the deflection scales of
 the reward and the success test (10 times larger for five booms, see Reward) differ.
 
 Dynamics (``fidelity``)
 -----------------------
-* ``"rl"`` (default): the stroke-parametric modal reduced-order model
-  ``sim_core.systems.telescopic.modal`` (in-plane modes of the full sim_core model, linearised about the
-  static equilibrium at each L_s; tables shipped in sim_core/systems/telescopic/data).  ~2e4 env steps/s on one
-  core, ~1000 times real time (benchmarks/results/env_speed.md).
-* ``"paper"``: the full sim_core model (``sim_core.systems.telescopic.build``, frictionless by default,
-  ``paper_n_nodes`` nodes per spline element, default 3; ``booms`` sections, synchronized
-  drive) advanced step by step: for each control step the targets of the telescopic cylinders
-  (every cylinder of the synchronized drive) are replaced by the env's stroke kinematics and
-  the model is integrated with ``sim_core.integrate.driver.integrate`` (rtol 1e-6, atol 1e-7) from
-  the current state.  Slow: ~50 env steps/s, a real-time factor of ~2.4 on one core at the
-  default 3 nodes, and a reset of ~0.3 s (benchmarks/results/env_speed.md); for checking
-  policies, not for training.
+Every fidelity runs through sim_core's public stepping API (:class:`sim_core.Simulation`,
+:class:`sim_core.Command`, :mod:`sim_core.rom`): each control step hands the plant the step's
+stroke kinematics (below) as one command.
 
-Stroke kinematics (both fidelities)
------------------------------------
+* ``"rl"`` (default): the stroke-parametric modal reduced-order model (in-plane modes of the
+  full sim_core model, linearised about the static equilibrium at each L_s; tables shipped with
+  sim_core, :mod:`sim_core.rom`) on the crane's modal scene (``telescopic_extraction_rl``; five
+  booms: ``telescopic_extraction_5`` with ``model.reduction = "modal"``), :class:`ModalPlant`.
+  ~2e4 env steps/s on one core, ~1000 times real time (benchmarks/results/env_speed.md).
+* ``"paper"``: the full sim_core model (scene ``telescopic_extraction`` or
+  ``telescopic_extraction_5``: ``booms`` sections, synchronized drive; frictionless by default,
+  ``paper_friction``; ``paper_n_nodes`` nodes per spline element, default 3; RK45 at rtol 1e-6,
+  atol 1e-7), :class:`boom_env.full_physics.FullPhysicsPlant`: for each control step every
+  telescopic cylinder follows the env's stroke kinematics and the model is integrated from the
+  current state.  Slow: ~50 env steps/s, a real-time factor of ~2.4 on one core at the default
+  3 nodes frictionless, and a reset of ~0.3 s (benchmarks/results/env_speed.md); for checking
+  policies, not for training.
+* ``"train"``: the full nonlinear model with the sliders' friction on (Section 8), at the
+  settings chosen from the convergence table benchmarks/results/training_fidelity.md (mesh,
+  tolerance and integrator, ``boom_env.full_physics.FIDELITIES["train"]``: the paper's 8
+  sub-elements per spline element, RK45 at rtol 1e-4, atol 1e-5): against the paper-accuracy
+  run of the paper's extraction its tip is within 0.03 mm and its cylinder force within 0.5 %
+  of the force's range.  A real-time factor of only ~0.4 on one core, slower than ``"paper"``
+  (frictionless on 2 sub-elements): with friction the coarser meshes are millimetres off and
+  no setting of the table reaches a real-time factor of 10.  ``paper_n_nodes`` and
+  ``paper_friction`` do not apply.
+
+Stroke kinematics (every fidelity)
+----------------------------------
 The action is held for one control step ``dt`` (s) (piecewise-constant acceleration), the env
 integrates L_s, v exactly: velocity saturation |v| <= v_max (the cylinder's flow limit: the
 acceleration is cut to 0 when the limit is reached, ``info["velocity_saturated"]``), end stops
@@ -72,14 +86,15 @@ Observation space
 
 The deflection is the tip position (innermost boom N = ``booms``, s = 10 m) minus the
 static-equilibrium tip of the same model at the current L_s (tables of the full model), i.e. the
-vibration plus the quasi-static inertial deflection.  With ``fidelity="paper"`` the reference is
-the full model's own equilibrium tip at reset moved by the tables' static tip change (the tables
-interpolate linearly between their stroke grid points, ~0.02 mm off the model's equilibrium).
+vibration plus the quasi-static inertial deflection.  With ``fidelity="paper"`` or ``"train"``
+the reference is the full model's own equilibrium tip at reset moved by the tables' static tip
+change (the tables interpolate between their stroke grid points, ~0.02 mm off the model's
+equilibrium).
 Deflections are mm-scale (cm with ``booms=5``): normalise observations (e.g. VecNormalize)
 for learning.  A deflection outside its bounds counts as divergence.
 
 ``observe_parameters=True`` appends the episode's payload and luffing angle, mapped linearly
-from the modal tables' range (``sim_core.systems.telescopic.modal.allowed_ranges``: 20-30 t with
+from the modal tables' range (``sim_core.rom.allowed_ranges``: 20-30 t with
 3 booms, 5-15 t with 5; 45-75 deg) to [-1, 1] (x_n = (2 x - lo - hi) / (hi - lo); the middle
 payload and 60 deg give 0).  With
 ``payload_range`` / ``angle_range`` the plant changes from episode to episode (first bending
@@ -132,8 +147,8 @@ randomisation: ``payload_range=(lo, hi)`` / ``angle_range=(lo, hi)`` draw them u
 ``self.np_random`` at every reset (seeded through reset(seed)).  The ROM tables cover payload
 20-30 t (5-15 t with ``booms=5``) and luffing angles 45-75 deg (tabulated at 45, 60, 75 deg and
 interpolated linearly between them: first bending frequency within 0.7 % of the full model's at
-52.5 deg, tests/env/test_modal.py; ``sim_core.systems.telescopic.modal.allowed_ranges``); values
-outside raise ValueError.
+52.5 deg, tests/env/test_modal.py; ``sim_core.rom.allowed_ranges``); values outside raise
+ValueError.
 
 Episode end
 -----------
@@ -174,6 +189,9 @@ The registered ids keep ``-v0``; their reward and observation changed as listed 
 * The ``booms`` option (3 default: unchanged; 5: the five-section crane, its own payload range
   and default payload, deflection scales and success tolerances 10 times the three-boom ones,
   ``info["booms"]``); ``d_ref``, ``dv_ref`` as constructor arguments.
+* ``fidelity="train"`` (an additive option: the full model with friction at the settings of
+  benchmarks/results/training_fidelity.md); the default ``"rl"`` and ``"paper"`` are unchanged
+  (their trajectories are pinned by tests/env/test_env_public_api.py).
 """
 
 from __future__ import annotations
@@ -184,9 +202,10 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from sim_core.errors import SimulationError
-from sim_core.systems.telescopic.modal import TABLE_BOOMS, ModalROM, allowed_ranges, tables_for
-from sim_core.validation.closed_form import luffing_geometry
+from sim_core import Command, Simulation, SimulationError, load_scene
+from sim_core.rom import TABLE_BOOMS, allowed_ranges, luffing_geometry, tables_for
+
+from .full_physics import FullPhysicsPlant
 
 BOOM_LENGTH = 10.0          # m, docs/model.md#input-sections
 BOOMS = tuple(TABLE_BOOMS)  # boom counts with modal tables: 3 (the paper's), 5
@@ -197,12 +216,79 @@ DEFAULT_PAYLOAD = {3: 25000.0, 5: 10000.0}   # kg: the paper scene's; the 5-sect
 DEFLECTION_REFS = {"d_ref": 1e-3, "dv_ref": 1e-2, "tol_deflection": 2e-4,
                    "tol_deflection_rate": 2e-3}
 DEFLECTION_SCALE = {3: 1.0, 5: 10.0}
+FIDELITIES = ("rl", "paper", "train")
+# the modal ROM's scene of each boom count (frictionless; model.reduction = "modal")
+MODAL_SCENES = {3: ("telescopic_extraction_rl", {}),
+                5: ("telescopic_extraction_5", {"model.reduction": "modal",
+                                                "effects.friction": False})}
+
+
+class ModalPlant:
+    """The stroke-parametric modal ROM (fidelity "rl") as the env's plant: a
+    :class:`sim_core.Simulation` of the crane's modal scene (``MODAL_SCENES``) with the
+    episode's payload (kg), luffing angle (deg) and start stroke L0 (m), at rest in its static
+    equilibrium.  ``L``, ``v``: the stroke (m) and its rate (m/s); ``q``, ``qd``: the modal
+    coordinates and rates; ``tb``: the modal tables (:class:`sim_core.rom.ModalTables`)."""
+
+    def __init__(self, booms: int, payload: float, angle_deg: float, stroke0: float,
+                 n_modes: int):
+        name, base = MODAL_SCENES[booms]
+        L0 = float(stroke0)
+        _, _, (L_lo, L_hi) = allowed_ranges(n_booms=booms)
+        scene = load_scene(name, overrides={
+            **base, "model.n_modes": int(n_modes), "payload.mass": float(payload),
+            "booms.luffing_angle_deg": float(angle_deg), "booms.stroke0": L0,
+            # the modal scene's drive is the cubic schedule from L0 (at rest there); a slow one
+            # (1.2 m over 12 s) towards the tables' far end keeps its stroke history within
+            # them from any L0.  The env commands the stroke from the first step on.
+            "drive.v_max": 0.1, "drive.t_hold_end": 12.0,
+            "drive.direction": "extraction" if L0 <= 0.5 * (L_lo + L_hi) else "retraction"})
+        self.sim = Simulation(scene)
+        self.tb = self.sim.system
+        self.start = self.sim.save_state()
+
+    def reset(self) -> None:
+        """Back to the start state (rest, static equilibrium at L0)."""
+        self.sim.restore_state(self.start)
+
+    def advance(self, segments, dt: float, end: tuple[float, float]) -> None:
+        """One control step of ``dt`` s along the stroke ``segments`` ((acceleration, duration,
+        rate jump at its end), ...), ending at (L_s, L_s') = ``end``."""
+        self.sim.advance(dt, {"telescopic": Command(tuple(segments), end)})
+
+    def tip_deflection(self) -> tuple[float, float, float, float]:
+        """(dX, dZ, dX', dZ') of the tip from the static tip at the current L_s (m, m/s)."""
+        out = self.sim.outputs(("tip_deflection", "tip_deflection_rate"))
+        d, dv = out["tip_deflection"], out["tip_deflection_rate"]
+        return float(d[0]), float(d[2]), float(dv[0]), float(dv[2])
+
+    def _state(self, key):
+        return self.sim.outputs((key,))[key]
+
+    @property
+    def L(self) -> float:
+        return self._state("actuators")["telescopic"][0]
+
+    @property
+    def v(self) -> float:
+        return self._state("actuators")["telescopic"][1]
+
+    @property
+    def q(self) -> np.ndarray:
+        return self._state("modal_coordinates")
+
+    @property
+    def qd(self) -> np.ndarray:
+        return self._state("modal_rates")
 
 
 class TelescopicBoomEnv(gym.Env):
     """See the module docstring for spaces, reward, start state and episode end."""
 
     metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 20}
+    #: modal plants kept per configuration (booms, n_modes, payload, angle, L0): a reset with
+    #: the same configuration restores the start state instead of rebuilding
+    MODAL_CACHE = 4
 
     def __init__(self, task: str = "extraction", fidelity: str = "rl", render_mode=None,
                  dt: float = 0.05, a_max: float = 0.25, v_max: float = 0.5,
@@ -221,12 +307,44 @@ class TelescopicBoomEnv(gym.Env):
                  render_exaggeration: float = 500.0):
         if task not in ("extraction", "retraction"):
             raise ValueError(f"task = {task!r}: allowed 'extraction', 'retraction'")
-        if fidelity not in ("rl", "paper"):
-            raise ValueError(f"fidelity = {fidelity!r}: allowed 'rl', 'paper'")
+        if fidelity not in FIDELITIES:
+            raise ValueError(f"fidelity = {fidelity!r}: allowed "
+                             f"{', '.join(map(repr, FIDELITIES))}")
         if isinstance(booms, bool) or booms not in BOOMS:
             raise ValueError(f"booms = {booms!r}: allowed {', '.join(map(str, BOOMS))} (the boom "
                              "counts with shipped modal tables, synchronized drive)")
         self.booms = int(booms)
+        # every numeric argument: a real number (TypeError otherwise), finite and in its range
+        # (ValueError), the message naming the argument
+        for name, v, lo in (("dt", dt, 0.0), ("a_max", a_max, 0.0), ("v_max", v_max, 0.0),
+                            ("t_max", t_max, 0.0), ("reward_scale", reward_scale, 0.0),
+                            ("render_exaggeration", render_exaggeration, 0.0)):
+            _real(name, v, lo, strict=True)
+        for name, v in (("w_time", w_time), ("w_progress", w_progress),
+                        ("w_deflection", w_deflection), ("w_rate", w_rate), ("w_effort", w_effort),
+                        ("w_jerk", w_jerk), ("w_end_stop", w_end_stop), ("bonus", bonus),
+                        ("tol_stroke", tol_stroke), ("tol_speed", tol_speed)):
+            _real(name, v, 0.0)
+        for name, v in (("tol_deflection", tol_deflection),
+                        ("tol_deflection_rate", tol_deflection_rate)):
+            if v is not None:
+                _real(name, v, 0.0)
+        for name, v in (("d_ref", d_ref), ("dv_ref", dv_ref)):
+            if v is not None:
+                _real(name, v, 0.0, strict=True)
+        if payload is not None:
+            _real("payload", payload)
+        _real("luffing_angle_deg", luffing_angle_deg)
+        for name, v in (("stroke_limits", stroke_limits), ("payload_range", payload_range),
+                        ("angle_range", angle_range)):
+            if v is not None:
+                _pair(name, v)
+        if isinstance(paper_n_nodes, bool) or not isinstance(paper_n_nodes, (int, np.integer)) \
+                or not 3 <= paper_n_nodes <= 33:
+            raise ValueError(f"paper_n_nodes = {paper_n_nodes!r}: allowed integers 3..33 "
+                             "(the scene key booms.n_nodes)")
+        if paper_friction not in (True, False):
+            raise ValueError(f"paper_friction = {paper_friction!r}: allowed True, False")
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode = {render_mode!r}: allowed {self.metadata['render_modes']}")
         for name, v in (("dt", dt), ("a_max", a_max), ("v_max", v_max), ("t_max", t_max),
@@ -246,12 +364,15 @@ class TelescopicBoomEnv(gym.Env):
             payload = DEFAULT_PAYLOAD[self.booms]
         self.payload0, self.angle0 = float(payload), float(luffing_angle_deg)
         self.payload_range, self.angle_range = payload_range, angle_range
-        for nm, rng in (("payload", payload_range), ("luffing_angle_deg", angle_range)):
+        for nm, arg, rng in (("payload", "payload_range", payload_range),
+                             ("luffing_angle_deg", "angle_range", angle_range)):
             if rng is not None:
-                self._check_range(nm, rng[0])
-                self._check_range(nm, rng[1])
+                self._check_range(nm, rng[0], arg)
+                self._check_range(nm, rng[1], arg)
         self._check_range("payload", self.payload0)
         self._check_range("luffing_angle_deg", self.angle0)
+        if not (isinstance(n_modes, (int, np.integer)) and 1 <= n_modes <= 4):
+            raise ValueError(f"n_modes = {n_modes!r}: allowed 1..4 (the tabulated in-plane modes)")
         self.n_modes, self.paper_n_nodes, self.paper_friction = n_modes, paper_n_nodes, paper_friction
         self.w = dict(time=w_time, progress=w_progress, deflection=w_deflection, rate=w_rate,
                       effort=w_effort, jerk=w_jerk, end_stop=w_end_stop, bonus=bonus)
@@ -284,14 +405,36 @@ class TelescopicBoomEnv(gym.Env):
         self.observation_space = spaces.Box(low, high, dtype=np.float32)
         self._fig = None
         self._state = None
+        self.plant = None
+        self._modal_plants: dict = {}
+        self._L = self._v = 0.0
 
     # -- helpers ---------------------------------------------------------------------------
-    def _check_range(self, name, value):
+    @property
+    def rom(self):
+        """The plant (its former name): ``L``, ``v`` (m, m/s) and ``advance``; with fidelity
+        "rl" the :class:`ModalPlant` (also ``q``, ``qd``, ``tb``)."""
+        return self.plant
+
+    @property
+    def _ts(self):
+        """The full model's system (fidelity "paper"/"train"; diagnostics and tests)."""
+        return self.plant.system
+
+    @property
+    def _y(self):
+        """The full model's integrated state (z, z') (fidelity "paper"/"train")."""
+        return self.plant.state
+
+    def _check_range(self, name, value, arg=None):
+        """``value`` of quantity ``name`` within the tables' range; the error names ``arg`` (the
+        argument that gave it, default ``name``)."""
         lo, hi = self._ranges[name]
         if not (math.isfinite(value) and lo - 1e-9 <= value <= hi + 1e-9):
-            raise ValueError(f"{name} = {value!r} outside the modal tables' range [{lo:g}, {hi:g}] "
-                             f"of booms = {self.booms} "
-                             "(sim_core.systems.telescopic.modal.allowed_ranges)")
+            given = name if arg is None else f"{arg} entry {name}"
+            raise ValueError(f"{given} = {value!r} outside the modal tables' range "
+                             f"[{lo:g}, {hi:g}] of booms = {self.booms} "
+                             "(sim_core.rom.allowed_ranges)")
 
     def _normalised(self, name, value):
         """``value`` mapped linearly from the tables' range of ``name`` to [-1, 1]."""
@@ -362,12 +505,18 @@ class TelescopicBoomEnv(gym.Env):
             if not (math.isfinite(x) and self.L_min <= x <= self.L_max):
                 raise ValueError(f"{nm} = {x!r}: allowed [{self.L_min:g}, {self.L_max:g}] m")
         self.payload, self.angle = payload, angle
-        self.tables = tables_for(payload, angle, self.n_modes, n_booms=self.booms)
         self.L_target, self.travel = Lt, max(abs(Lt - L0), 1e-3)
         self.t, self.a_prev, self._a_applied = 0.0, 0.0, 0.0
-        self.rom = ModalROM(self.tables, L0, 0.0)
-        if self.fidelity == "paper":
-            self._paper_reset(L0)
+        self._L, self._v = L0, 0.0
+        if self.fidelity == "rl":
+            self.plant = self._modal_plant(payload, angle, L0)
+            self.tables = self.plant.tb
+        else:
+            self.plant = FullPhysicsPlant(
+                booms=self.booms, fidelity=self.fidelity, payload=payload, angle_deg=angle,
+                stroke0=L0, friction=True if self.fidelity == "train" else self.paper_friction,
+                n_nodes=self.paper_n_nodes if self.fidelity == "paper" else None)
+            self.tables = tables_for(payload, angle, self.n_modes, n_booms=self.booms)
         self._defl = np.zeros(4)
         self._update_deflection()
         obs = self._obs()
@@ -376,6 +525,20 @@ class TelescopicBoomEnv(gym.Env):
             self.render()
         return obs, self._info(False, False)
 
+    def _modal_plant(self, payload, angle, L0) -> ModalPlant:
+        """The ROM plant of this configuration at its start state (kept for MODAL_CACHE
+        configurations: a repeated configuration is restored, not rebuilt)."""
+        key = (self.booms, self.n_modes, payload, angle, L0)
+        plant = self._modal_plants.pop(key, None)
+        if plant is None:
+            plant = ModalPlant(self.booms, payload, angle, L0, self.n_modes)
+        else:
+            plant.reset()
+        self._modal_plants[key] = plant                    # most recently used last
+        while len(self._modal_plants) > self.MODAL_CACHE:
+            self._modal_plants.pop(next(iter(self._modal_plants)))
+        return plant
+
     def step(self, action):
         a_in = np.asarray(action, dtype=np.float64).reshape(-1)
         if a_in.shape != (1,):
@@ -383,23 +546,14 @@ class TelescopicBoomEnv(gym.Env):
         if not np.all(np.isfinite(a_in)):
             raise ValueError(f"action = {action!r} is not finite")
         a = float(np.clip(a_in[0], -1.0, 1.0)) * self.a_max
-        segs, L1, v1, sat, stop = self._segments(self.rom.L, self.rom.v, a)
+        segs, L1, v1, sat, stop = self._segments(self._L, self._v, a)
         diverged, reason = False, ""
         try:
-            if self.fidelity == "rl":
-                for ae, tau, jump in segs:
-                    if tau > 0:
-                        self.rom.advance(ae, tau)
-                    if jump:
-                        g = self.tables.coefficients(self.rom.L)[2]
-                        self.rom.qd = self.rom.qd - g * jump
-                        self.rom.v += jump
-            else:
-                self._paper_advance(segs)
-            self.rom.L, self.rom.v = L1, v1
+            self.plant.advance(segs, self.dt, (L1, v1))
+            self._L, self._v = L1, v1
             self._update_deflection()
-            if not math.isfinite(float(self._defl.sum() + self.rom.q.sum() + self.rom.qd.sum())):
-                raise FloatingPointError("non-finite modal state")
+            if not math.isfinite(float(self._defl.sum())):
+                raise FloatingPointError("non-finite plant state")
             dX, dZ, vX, vZ = self._defl
             if max(abs(dX), abs(dZ)) > 1.0 or max(abs(vX), abs(vZ)) > 10.0:
                 raise FloatingPointError(f"tip deflection {self._defl} outside the observation bounds")
@@ -410,15 +564,15 @@ class TelescopicBoomEnv(gym.Env):
         d = math.hypot(self._defl[0], self._defl[1])
         dv = math.hypot(self._defl[2], self._defl[3])
         w = self.w
-        reward = -self.dt * (w["time"] + w["progress"] * abs(self.rom.L - self.L_target) / self.travel
+        reward = -self.dt * (w["time"] + w["progress"] * abs(self._L - self.L_target) / self.travel
                              + w["effort"] * (a / self.a_max) ** 2)
         if not diverged:
             reward -= self.dt * (w["deflection"] * (d / self.d_ref) ** 2 + w["rate"] * (dv / self.dv_ref) ** 2)
         reward -= w["jerk"] * ((a - self.a_prev) / self.a_max) ** 2 + (w["end_stop"] if stop else 0.0)
         self.a_prev = a
         self._a_applied = a_applied
-        settled = (not diverged and abs(self.rom.L - self.L_target) < self.tol["stroke"]
-                   and abs(self.rom.v) < self.tol["speed"] and d < self.tol["deflection"]
+        settled = (not diverged and abs(self._L - self.L_target) < self.tol["stroke"]
+                   and abs(self._v) < self.tol["speed"] and d < self.tol["deflection"]
                    and dv < self.tol["rate"])
         if settled:
             reward += w["bonus"]
@@ -439,7 +593,7 @@ class TelescopicBoomEnv(gym.Env):
 
     def _obs(self):
         a = self._a_applied
-        o = [self.rom.L, self.rom.v, a, self.L_target, max(self.t_max - self.t, 0.0), *self._defl]
+        o = [self._L, self._v, a, self.L_target, max(self.t_max - self.t, 0.0), *self._defl]
         if self.observe_parameters:
             o += [self._normalised("payload", self.payload),
                   self._normalised("luffing_angle_deg", self.angle)]
@@ -447,7 +601,7 @@ class TelescopicBoomEnv(gym.Env):
         return np.clip(o, self.observation_space.low, self.observation_space.high).astype(np.float32)
 
     def _info(self, sat, stop):
-        return {"time": self.t, "stroke": self.rom.L, "stroke_rate": self.rom.v,
+        return {"time": self.t, "stroke": self._L, "stroke_rate": self._v,
                 "velocity_saturated": bool(sat), "end_stop": bool(stop),
                 "tip_deflection": self._defl[:2].copy(), "payload": self.payload,
                 "luffing_angle_deg": self.angle, "fidelity": self.fidelity, "booms": self.booms,
@@ -455,59 +609,7 @@ class TelescopicBoomEnv(gym.Env):
 
     def _update_deflection(self):
         """self._defl = (dX, dZ, dX', dZ') of the tip relative to the static tip at L_s (m, m/s)."""
-        if self.fidelity == "rl":
-            self._defl = np.array(self.rom.deflection())
-            return
-        else:
-            r, v = self._paper_tip()
-            rs, drs = self.tables.static_tip(self.rom.L)
-            d, dv = r - rs - self._tip_offset, v - drs * self.rom.v
-        self._defl = np.array([d[0], d[2], dv[0], dv[2]], dtype=np.float64)
-
-    # -- paper fidelity -----------------------------------------------------------------------
-    def _paper_reset(self, L0):
-        from dataclasses import replace
-
-        from sim_core.systems.telescopic.params import TelescopicParams
-        from sim_core.systems.telescopic.build import build_telescopic, initial_equilibrium
-        p = replace(TelescopicParams(n_booms=self.booms, mechanism="synchronized"),
-                    payload=self.payload, luffing_angle_deg=self.angle, stroke0=L0,
-                    n_nodes=self.paper_n_nodes, friction=self.paper_friction)
-        self._ts = build_telescopic(p)
-        z, _ = initial_equilibrium(self._ts)
-        self._y = np.concatenate([z, np.zeros_like(z)])
-        # synchronized drive: every cylinder (stages 1-2, 3-4, ...) follows the env's stroke
-        self._cyls = [c for c in self._ts.model.nonlinear if c.name in self._ts.drives]
-        self._kin = (L0, 0.0, [])
-        for c in self._cyls:
-            c.target = self._target
-        # deflection reference: the model's own equilibrium tip at the start, moved with the
-        # tables' static tip (interpolated between the stroke grid points, ~0.02 mm off the
-        # model's equilibrium at other strokes)
-        self._tip_offset = self._paper_tip()[0] - self.tables.static_tip(L0)[0]
-
-    def _target(self, t):
-        """Cylinder length, rate, acceleration at local time t (s) of the current step."""
-        L, v, segs = self._kin
-        for ae, tau, jump in segs:
-            if t <= tau:
-                return (L + v * t + 0.5 * ae * t * t, v + ae * t, ae)
-            L, v, t = L + v * tau + 0.5 * ae * tau * tau, v + ae * tau + jump, t - tau
-        return (L + v * t, v, 0.0)
-
-    def _paper_advance(self, segs):
-        from sim_core.integrate.driver import integrate
-        self._kin = (self.rom.L, self.rom.v, segs)
-        _, ys, _ = integrate(self._ts.model, self._y, self.dt,
-                                  {"rtol": 1e-6, "atol": 1e-7, "n_output": 2})
-        self._y = ys[-1]
-
-    def _paper_tip(self):
-        m = self._ts.model
-        n = m.n_dof
-        Q, Qd = m.full_state(0.0, self._y[:n], self._y[n:])
-        r, J, _, _ = self._ts.tip(Q)
-        return np.real(r), np.real(J @ Qd)
+        self._defl = np.array(self.plant.tip_deflection(), dtype=np.float64)
 
     # -- rendering ---------------------------------------------------------------------------
     def render(self):
@@ -539,7 +641,7 @@ class TelescopicBoomEnv(gym.Env):
         ax.clear()
         geo = luffing_geometry(math.radians(self.angle))
         O, e = np.asarray(geo.origin)[[0, 2]], np.asarray(geo.e_s)[[0, 2]]
-        L = self.rom.L
+        L = self._L
         d = self.exaggeration * self._defl[:2]
         n = self.booms
         total = (n - 1) * L + BOOM_LENGTH                  # boom k's left end at k L_s (synchronized)
@@ -573,6 +675,30 @@ class TelescopicBoomEnv(gym.Env):
             plt.close(self._human)
             self._human = None
         self._fig = None
+
+
+def _real(name, value, lo=-math.inf, strict=False):
+    """``value`` as a float: a real number (bool excluded; TypeError otherwise), finite and
+    >= lo (> lo with ``strict``; ValueError otherwise), the message naming the argument."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise TypeError(f"{name} = {value!r}: must be a real number")
+    v = float(value)
+    if not math.isfinite(v) or v < lo or (strict and v == lo):
+        bound = f"> {lo:g}" if strict else f">= {lo:g}"
+        raise ValueError(f"{name} = {value!r}: must be finite and {bound}")
+    return v
+
+
+def _pair(name, value):
+    """A (lo, hi) pair of finite real numbers with lo <= hi, the message naming the argument."""
+    try:
+        lo, hi = value
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} = {value!r}: must be a pair (lo, hi) of numbers") from None
+    lo, hi = _real(name, lo), _real(name, hi)
+    if lo > hi:
+        raise ValueError(f"{name} = {value!r}: lo must not exceed hi")
+    return lo, hi
 
 
 def _first_hit(L, v, a, stop):

@@ -1,8 +1,8 @@
 """sim_core: moving-boundary dynamics of flexible telescopic crane booms.
 
 Reference: T. Zhao, Z. Qi, T. Wang, "Dynamic Contact Analysis of Flexible Telescopic Boom
-Systems with Moving Boundary", Mathematics 12 (2024) 2496 (the "first seed"), and the
-folding long-boom manipulator paper (SIMULTECH 2020, the "second seed").  SI units throughout.
+Systems with Moving Boundary", Mathematics 12 (2024) 2496 (doi:10.3390/math12162496), and the
+folding long-boom manipulator paper (SIMULTECH 2020).  SI units throughout.
 
     from sim_core import load_scene
     from sim_core import simulate
@@ -20,9 +20,10 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 
 from sim_core._version import __version__  # noqa: E402
 from sim_core.api import load_scene, simulate  # noqa: E402
+from sim_core.commands import Command  # noqa: E402
 from sim_core.errors import ResultFormatError, SceneError, SimulationError  # noqa: E402
 from sim_core.result import Result  # noqa: E402
 from sim_core.simulation import Simulation  # noqa: E402
 
-__all__ = ["load_scene", "simulate", "Simulation", "Result", "ResultFormatError", "SceneError",
-           "SimulationError", "__version__"]
+__all__ = ["load_scene", "simulate", "Simulation", "Command", "Result", "ResultFormatError",
+           "SceneError", "SimulationError", "__version__"]

@@ -13,6 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from sim_core.checkpoint import CheckpointPolicy, Checkpointer, ambient, scene_fingerprint
 from sim_core.registry import system_kind
 from sim_core.result import Result
 from sim_core.scene.io import apply_overrides, read_scene
@@ -28,12 +29,30 @@ def load_scene(name_or_path: str | Path, overrides: dict[str, Any] | None = None
     return system_kind(raw).validate(raw, source)
 
 
-def simulate(scene: dict, progress=None) -> Result:
+def simulate(scene: dict, progress=None, *, checkpoint: CheckpointPolicy | None = None,
+             resume: bool | str = False) -> Result:
     """Run a validated scene (:func:`load_scene`) and return its Result.
 
     ``progress``: an optional callable ``progress(t, wall_s)`` (simulated and wall time, s).  A failed solve
     raises :class:`sim_core.SimulationError` with the time and the reason, its partial result
     attached as ``.result`` where one exists; a result that fails its own checks grossly raises
     :class:`sim_core.errors.SuspectResult`, and a milder failure marks it (``Result.suspect``).
+
+    ``checkpoint``: a :class:`sim_core.checkpoint.CheckpointPolicy` (file, wall seconds between
+    checkpoints): the integration writes its whole state there, atomically, so that a killed
+    run can continue.  ``resume``: False (start at t = 0), True (continue from the policy's
+    checkpoint, which must be one of this scene: :class:`sim_core.checkpoint.CheckpointError`
+    otherwise) or ``"auto"`` (continue where a usable checkpoint of this scene exists, else
+    start at t = 0).  The resumed result is bit-identical to the uninterrupted run's
+    (:mod:`sim_core.checkpoint`).  The file stays after the run;
+    :meth:`~sim_core.checkpoint.CheckpointPolicy.clear` removes it.  Without ``checkpoint``,
+    the policy of an enclosing :func:`sim_core.checkpoint.checkpointing` block applies.
     """
-    return system_kind(scene).run(scene, progress)
+    if checkpoint is None and not resume and ambient() is not None:
+        checkpoint, resume = ambient()
+    if checkpoint is None:
+        if resume:
+            raise ValueError("resume needs the checkpoint policy to resume from (checkpoint=)")
+        return system_kind(scene).run(scene, progress)
+    ckpt = Checkpointer(checkpoint, scene_fingerprint(scene), resume)
+    return system_kind(scene).run(scene, progress, checkpoint=ckpt)

@@ -1,10 +1,16 @@
-"""Command line: ``boom-sim run|sweep|list|describe|plot|animate|export``.
+"""Command line: ``boom-sim run|sweep|list|describe|plot|animate|export|report``.
 
-Errors in the scene (or an unreadable result file for ``plot``) exit with status 2 and a
-one-line message; a failed solve exits with status 3 and a one-line message (time and reason),
-after writing summary.json with the error and, if the solver attached one to the
-SimulationError (``.result``), the partial result.npz.  ``sweep`` (:mod:`sim_core.sweep`) exits
-with status 2 for an invalid case or grid before running anything, 3 if any case failed (the
+``run`` writes result.npz, summary.json, the figures and report.html (:mod:`sim_core.report`:
+one self-contained page with the summary, the self-checks and an interactive plot of every
+output; ``--no-report`` skips it); ``report`` writes that page again from a result file.
+While it runs, ``run`` keeps the integrator's whole state in OUT/checkpoint.pkl
+(``--checkpoint-every``, every 30 wall seconds by default; :mod:`sim_core.checkpoint`) and
+``run --resume`` continues a killed run from it; a bad checkpoint exits with status 2.
+Errors in the scene (or an unreadable result file for ``plot``, ``report``, ...) exit with
+status 2 and a one-line message; a failed solve exits with status 3 and a one-line message
+(time and reason), after writing summary.json with the error and, if the solver attached one
+to the SimulationError (``.result``), the partial result.npz.  ``sweep`` (:mod:`sim_core.sweep`)
+exits with status 2 for an invalid case or grid before running anything, 3 if any case failed (the
 others still run) and 130 when interrupted (finished cases and the summary are kept).
 """
 
@@ -12,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import sys
 import time
 from pathlib import Path
@@ -21,6 +28,13 @@ from sim_core.errors import SceneError, SimulationError
 from sim_core.registry import system_kind
 from sim_core.result import Result, atomic_write_bytes
 from sim_core.scene.io import shipped_scenes
+
+
+def _plain(text: str) -> str:
+    """A docstring line for the terminal: reST literals (``x``) and roles (:mod:`x`) as plain
+    text."""
+    text = re.sub(r":[a-z]+:`~?([^`]+)`", r"\1", text)
+    return text.replace("``", "")
 
 
 def _overrides(items: list[str] | None) -> dict:
@@ -69,24 +83,57 @@ def _one_line(msg: object) -> str:
     return " ".join(str(msg).split())
 
 
+def _checkpoint_policy(args, out: Path):
+    """``run``'s checkpoint policy: OUT/checkpoint.pkl every --checkpoint-every wall seconds
+    (required: a run path without checkpoints is refused), by default every 30 s where the
+    run path has them (a run shorter than that writes none); --checkpoint-every 0: none."""
+    from sim_core.checkpoint import DEFAULT_EVERY_S, CheckpointPolicy
+    every = args.checkpoint_every
+    if every is not None and not every >= 0:
+        raise _InputError(f"--checkpoint-every {every:g}: wall seconds between checkpoints, "
+                          "allowed [0, inf) (0: no checkpoints)")
+    if every == 0:
+        if args.resume:
+            raise _InputError("--resume with --checkpoint-every 0: a resume reads the "
+                              "checkpoint (leave --checkpoint-every out or give it > 0)")
+        return None
+    return CheckpointPolicy(out / CHECKPOINT_FILE, DEFAULT_EVERY_S if every is None else every,
+                            required=every is not None)
+
+
+CHECKPOINT_FILE = "checkpoint.pkl"
+
+
 def cmd_run(args) -> int:
+    from sim_core.checkpoint import CheckpointError, checkpointing
     scene = load_scene(args.scene, _overrides(args.set))
     out = Path(args.out)
+    policy = _checkpoint_policy(args, out)
     prog = _Progress(scene["solver"]["t_end"], not args.quiet)
     try:
-        result = simulate(scene, progress=prog)
+        with checkpointing(policy, resume=bool(args.resume)):
+            result = simulate(scene, progress=prog)
+    except CheckpointError as exc:
+        prog.close(finished=False)
+        raise _InputError(str(exc)) from None
     except SimulationError as exc:
         prog.close(finished=False)
         note = _save_failure(scene, out, exc)
+        if policy is not None and Path(policy.path).is_file():
+            note += f"; the last checkpoint is kept ({policy.path}: --resume continues from it)"
         print(f"boom-sim: {_one_line(exc)}{note}", file=sys.stderr)
         return 3
     prog.close()
     result.save(out / "result.npz")
     summary = {"scene": scene["name"], **result.stats}
     atomic_write_bytes(out / "summary.json", json.dumps(summary, indent=2, default=str).encode())
+    if policy is not None:          # the result is written: the checkpoint is obsolete
+        policy.clear()
     figs = [] if args.no_plots else _plots(result, out)
     if args.animate:
         figs.append(_animate(result, out / "anim.gif"))
+    report = None if args.no_report else _report(result, out / "report.html",
+                                                 out / "anim.gif" if args.animate else None)
     st = result.stats
     wall = float(st.get("wall_time_s", 0.0))
     rtf = st.get("real_time_factor", scene["solver"]["t_end"] / max(wall, 1e-12))
@@ -94,7 +141,8 @@ def cmd_run(args) -> int:
                      (("n_steps", "steps"), ("n_rhs", "RHS")) if k in st)
     print(f"{scene['name']}: {scene['solver']['t_end']:g} s simulated in {wall:.1f} s wall "
           f"(RTF {rtf:.3g})" + (f"; {work}" if work else "") + f"; wrote {out}/result.npz, "
-          f"summary.json" + (f", {len(figs)} figures" if figs else ""))
+          f"summary.json" + (f", {len(figs)} figures" if figs else "")
+          + (", report.html" if report else ""))
     if result.suspect:                 # a cheap self-check failed (summary.json: failed_checks)
         print(f"boom-sim: warning: {result.suspect_note()}", file=sys.stderr)
     return 0
@@ -167,6 +215,34 @@ def cmd_export(args) -> int:
     return 0
 
 
+def _report(result: Result, path: Path, animation: Path | None = None) -> Path | None:
+    """The run's report (sim_core.report); a missing plotly only skips it (the result files
+    are already written), a bad animation file or a failed write is an input error."""
+    try:
+        import plotly  # noqa: F401
+
+        from sim_core.report import write_report
+    except ImportError:
+        print("boom-sim: warning: plotly is not installed, report.html skipped", file=sys.stderr)
+        return None
+    try:
+        return write_report(result, path, animation=animation)
+    except (ValueError, OSError) as exc:
+        raise _InputError(f"cannot write the report: {_one_line(exc)}") from None
+
+
+def cmd_report(args) -> int:
+    res = _load_result(args.result)
+    out = Path(args.out) if args.out else Path(args.result).parent / "report.html"
+    try:
+        import plotly  # noqa: F401
+    except ImportError:
+        raise _InputError("plotly is not installed (pip install plotly)") from None
+    path = _report(res, out, Path(args.animation) if args.animation else None)
+    print(f"wrote {path}")
+    return 0
+
+
 def _plots(result: Result, out: Path) -> list:
     """Figures; a missing matplotlib only skips them (the result files are already written)."""
     try:
@@ -229,8 +305,13 @@ def cmd_sweep(args) -> int:
         raise SceneError(f"--grid {both[0]} and --set {both[0]}: a key is either swept or fixed")
     t0 = time.perf_counter()
     try:
+        every = args.checkpoint_every
+        if not every >= 0:
+            raise _InputError(f"--checkpoint-every {every:g}: wall seconds between a case's "
+                              "checkpoints, allowed [0, inf) (0: none)")
         rows = run_sweep(args.scene, grid, args.out, fixed=fixed, address=args.address,
-                         workers=args.workers, quiet=args.quiet, plots=args.plots)
+                         workers=args.workers, quiet=args.quiet, plots=args.plots,
+                         retries=args.retries, checkpoint_every=every or float("inf"))
     except SweepError as exc:
         raise _InputError(str(exc)) from None
     except KeyboardInterrupt:
@@ -261,7 +342,10 @@ too if pyarrow is installed: overrides, status ok/failed/skipped, error type and
 wall time, steps, scalar outcomes) and summary.png (each outcome against the first grid key).
 Every case is validated before anything runs.  Running the same command again skips the
 cases already done; a failed case is recorded and the others go on; Ctrl-C keeps the
-finished cases.  Needs Ray (pip install 'telescopic-boom-sim[cluster]').
+finished cases.  A case whose worker process dies (killed, out of memory) is retried
+--retries times, resuming from its checkpoint (OUT/.checkpoints, every --checkpoint-every
+wall seconds), then recorded as failed; running the command again runs only the failed and
+missing cases.  Needs Ray (pip install 'telescopic-boom-sim[cluster]').
 
 example:
   boom-sim sweep telescopic_extraction_rl --grid payload.mass=20000,25000,30000 \\
@@ -279,7 +363,7 @@ sweeps:
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="boom-sim", description=__doc__.splitlines()[0],
+    p = argparse.ArgumentParser(prog="boom-sim", description=_plain(__doc__.splitlines()[0]),
                                 epilog=_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="cmd", required=True)
     r = sub.add_parser("run", help="simulate a scene, write result.npz, summary.json, figures")
@@ -290,6 +374,17 @@ def main(argv: list[str] | None = None) -> int:
     r.add_argument("--no-plots", action="store_true")
     r.add_argument("--animate", action="store_true",
                    help="also write anim.gif, the crane in motion (telescopic full model)")
+    r.add_argument("--no-report", action="store_true",
+                   help="no report.html (the summary, checks and every output, plotly)")
+    r.add_argument("--checkpoint-every", type=float, default=None, metavar="S",
+                   help="write the integrator's whole state to OUT/checkpoint.pkl at most every "
+                        "S wall seconds (default: 30 where the run path has checkpoints; a run "
+                        "shorter than that writes none; 0: none); removed once the result is "
+                        "written")
+    r.add_argument("--resume", action="store_true",
+                   help="continue from OUT/checkpoint.pkl (exit 2 if there is none, or if it "
+                        "was written for another scene); the result equals the uninterrupted "
+                        "run's")
     r.set_defaults(func=cmd_run)
     sw = sub.add_parser("sweep", help="run the Cartesian product of scene overrides as Ray tasks",
                         description=_SWEEP_HELP, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -308,6 +403,12 @@ def main(argv: list[str] | None = None) -> int:
     sw.add_argument("--plots", action="store_true",
                     help="also write the figures of 'run' into every case folder")
     sw.add_argument("--quiet", action="store_true", help="no progress bar")
+    sw.add_argument("--retries", type=int, default=2, metavar="N",
+                    help="run a case whose worker process died up to N more times, then record "
+                         "it as failed (default: %(default)s)")
+    sw.add_argument("--checkpoint-every", type=float, default=30.0, metavar="S",
+                    help="a case's checkpoint every S wall seconds, which its retry resumes "
+                         "from (default: %(default)g; 0: none)")
     sw.set_defaults(func=cmd_sweep)
     sub.add_parser("list", help="shipped scenes").set_defaults(func=cmd_list)
     d = sub.add_parser("describe", help="resolved scene, effects and DOF count")
@@ -341,6 +442,14 @@ def main(argv: list[str] | None = None) -> int:
     ex.add_argument("--vtk", required=True, metavar="DIR",
                     help="folder for result.pvd and one .vtu per output time")
     ex.set_defaults(func=cmd_export)
+    rp = sub.add_parser("report", help="one HTML page of a result: summary, checks, every "
+                                       "output as an interactive plot")
+    rp.add_argument("result")
+    rp.add_argument("--out", default=None,
+                    help="the HTML file (default: report.html beside the result)")
+    rp.add_argument("--animation", default=None, metavar="FILE",
+                    help="a GIF or MP4 (boom-sim animate) to embed in the page")
+    rp.set_defaults(func=cmd_report)
     args = p.parse_args(argv)
     try:
         return args.func(args)

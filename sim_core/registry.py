@@ -26,7 +26,7 @@ def kind_name(scene: dict) -> str:
     """The kind a raw or resolved scene names (``DEFAULT_KIND`` where it names none).  A result
     loaded from a file records its scene; one run from parameters records ``kind`` too."""
     kind = scene.get("kind", DEFAULT_KIND) if isinstance(scene, dict) else DEFAULT_KIND
-    if kind not in KINDS:
+    if not isinstance(kind, str) or kind not in KINDS:
         raise SceneError(f"kind = {kind!r}: no such system kind (allowed: "
                          f"{', '.join(sorted(KINDS))}){did_you_mean(kind, KINDS)}")
     return kind

@@ -26,11 +26,26 @@ Output folder ``out``:
 * ``summary.png``: each scalar outcome against the first grid key.
 
 Resuming: a case whose folder holds a successful run of the same resolved scene (same SHA-256
-of the validated scene) is skipped and its row is read back from the folder; failed cases run
-again.  A failing case (any exception in the simulation, e.g. a
+of the validated scene) is skipped and its row is read back from the folder; failed and
+missing cases run again.  A failing case (any exception in the simulation, e.g. a
 :class:`sim_core.errors.SimulationError`) is recorded with its error type and does not stop the
 sweep.  On Ctrl-C the running tasks are cancelled, the finished case folders stay, and the
 summary is written before the KeyboardInterrupt propagates.
+
+Faults of the workers: a case whose worker process dies (SIGKILL, the kernel's or Ray's
+out-of-memory killer, a lost node) is retried up to ``retries`` times (Ray's ``max_retries``,
+system failures only: an exception of the simulation is a result, not retried), then recorded
+as failed with Ray's error type (``WorkerCrashedError``, ``OutOfMemoryError``,
+``NodeDiedError``, ...) and the reason; the sweep goes on, and a re-run runs only the failed
+and missing cases.  Every case runs with checkpoints (:mod:`sim_core.checkpoint`, every
+``checkpoint_every`` wall seconds, 30 by default: a case shorter than that writes none) in
+``out/.checkpoints/<case>.pkl``, and a retried or re-run case resumes from its checkpoint
+(``resumed_from_s`` in its summary.json; its result is bit-identical to an uninterrupted
+run's).  The checkpoint path is an absolute path on the driver's machine: the retrying worker
+finds it where it can read that path (always on a local Ray; on a cluster, where the folder
+is on a file system shared by the nodes); elsewhere the retry starts from t = 0.  A case's
+checkpoint is removed once its folder is written (a case whose worker died keeps it for the
+re-run), and the ``.checkpoints`` folder once it is empty.
 
 Ray is imported inside :func:`run_sweep` only: ``import sim_core.sweep`` needs no Ray.
 """
@@ -55,6 +70,7 @@ from typing import Any, Callable
 import numpy as np
 
 from sim_core.api import load_scene, simulate
+from sim_core.checkpoint import DEFAULT_EVERY_S, CheckpointPolicy, scene_fingerprint
 from sim_core.errors import SceneError
 from sim_core.registry import system_kind
 from sim_core.result import Result, atomic_write_bytes, json_default
@@ -65,6 +81,9 @@ CASE_SUMMARY = "summary.json"
 BASE_FIELDS = ("case", "status", "error_type", "error", "wall_s", "n_steps")
 _TEMP_DIR = re.compile(r"^\..+\.(tmp|old)-[0-9a-f]{32}$")
 _MAX_NAME = 120                       # characters of a case folder name (file systems allow 255)
+CHECKPOINTS = ".checkpoints"          # the cases' checkpoint files, in the output folder
+#: retries of a case whose worker process died (Ray's max_retries)
+DEFAULT_RETRIES = 2
 
 
 class SweepError(RuntimeError):
@@ -156,12 +175,6 @@ def case_name(overrides: dict[str, Any]) -> str:
     digest = hashlib.sha1(json.dumps({k: _text(v) for k, v in overrides.items()},
                                      sort_keys=True).encode()).hexdigest()[:8]
     return f"{safe.lstrip('.')[:_MAX_NAME]}-{digest}"
-
-
-def scene_fingerprint(scene: dict) -> str:
-    """SHA-256 of the validated scene (its file path left out): equal fingerprints, equal runs."""
-    body = {k: v for k, v in scene.items() if k != "source"}
-    return hashlib.sha256(json.dumps(body, sort_keys=True, default=str).encode()).hexdigest()
 
 
 def prepare_cases(scene: str | Path, cases: list[dict], fixed: dict | None = None) -> list[dict]:
@@ -264,16 +277,23 @@ def _partial(exc: BaseException) -> Result | None:
     return None
 
 
-def run_case(scene: dict) -> dict:
+def run_case(scene: dict, checkpoint: str | None = None,
+             checkpoint_every: float = DEFAULT_EVERY_S) -> dict:
     """Simulate one validated scene; never raises for a failed simulation.
+
+    ``checkpoint``: the case's checkpoint file (None: none): written every
+    ``checkpoint_every`` wall seconds, and resumed from where it holds a checkpoint of this
+    scene (``resume="auto"``: a retry of a case whose worker died).
 
     Returns {status "ok"/"failed", error_type, error (one line), wall_s (wall time of
     :func:`sim_core.integrate.driver` incl. model build, s), n_steps, outcomes, stats, result (the
     Result, or the partial result a failed solver attached, or None), t_fail_s}."""
     t0 = time.perf_counter()
     rec: dict[str, Any] = {"status": "ok", "error_type": None, "error": None, "t_fail_s": None}
+    policy = None if checkpoint is None else \
+        CheckpointPolicy(checkpoint, checkpoint_every, required=False)
     try:
-        res = simulate(scene)
+        res = simulate(scene, checkpoint=policy, resume="auto" if policy else False)
     except Exception as exc:  # noqa: BLE001 - any failure is recorded with its type
         res = _partial(exc)
         rec.update(status="failed", error_type=type(exc).__name__, error=_one_line(exc),
@@ -341,6 +361,26 @@ def completed_case(folder: Path, fingerprint: str) -> dict | None:
             or summary.get("scene_sha256") != fingerprint or not (folder / RESULT_FILE).is_file()):
         return None
     return summary
+
+
+def _checkpoint_file(out: Path, case: dict) -> Path:
+    """A case's checkpoint: an absolute path, for workers whose working folder differs."""
+    return out.resolve() / CHECKPOINTS / f"{case['name']}.pkl"
+
+
+def _remove_checkpoint(out: Path, case: dict) -> None:
+    try:
+        os.unlink(_checkpoint_file(out, case))
+    except OSError:
+        pass
+
+
+def _remove_checkpoint_folder(out: Path) -> None:
+    """The checkpoint folder, once no case keeps a checkpoint there."""
+    try:
+        (out / CHECKPOINTS).rmdir()
+    except OSError:                   # missing, or a case whose worker died keeps its own
+        pass
 
 
 def _remove_stale_temporaries(out: Path) -> None:
@@ -520,7 +560,8 @@ def _start_ray(address: str | None, workers: int | None):
 def run_sweep(scene: str | Path, grid: dict[str, list] | None, out: str | Path, *,
               cases: list[dict] | None = None, fixed: dict | None = None,
               address: str | None = None, workers: int | None = None, quiet: bool = False,
-              plots: bool = False,
+              plots: bool = False, retries: int = DEFAULT_RETRIES,
+              checkpoint_every: float = DEFAULT_EVERY_S,
               on_case: Callable[[dict, dict | None], None] | None = None) -> list[dict]:
     """Run a sweep of ``scene`` (shipped name or TOML path) and return the summary rows.
 
@@ -534,6 +575,8 @@ def run_sweep(scene: str | Path, grid: dict[str, list] | None, out: str | Path, 
     workers: at most this many cases at a time (local Ray: started with this many CPUs).
     quiet:   no progress bar.
     plots:   also write the figures of ``boom-sim run`` into every successful case folder.
+    retries: times a case whose worker process died is run again (module docstring).
+    checkpoint_every: wall seconds between a case's checkpoints (``math.inf``: none).
     on_case: called in the driver as on_case(row, record) after each case has finished
              (record: :func:`run_case`'s dict, None for a skipped case).
 
@@ -547,6 +590,12 @@ def run_sweep(scene: str | Path, grid: dict[str, list] | None, out: str | Path, 
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
                                 or workers < 1):
         raise SweepError(f"workers = {workers!r}: must be an integer >= 1")
+    if isinstance(retries, bool) or not isinstance(retries, int) or retries < 0:
+        raise SweepError(f"retries = {retries!r}: must be an integer >= 0")
+    if isinstance(checkpoint_every, bool) or not isinstance(checkpoint_every, (int, float)) \
+            or not checkpoint_every > 0:
+        raise SweepError(f"checkpoint_every = {checkpoint_every!r}: wall seconds between a "
+                         "case's checkpoints, allowed (0, inf] (inf: none)")
     case_list = [dict(c) for c in cases] if cases is not None else grid_cases(grid or {})
     keys = list(grid) if cases is None else list(dict.fromkeys(k for c in case_list for k in c))
     prepared = prepare_cases(scene, case_list, fixed)          # fail fast: nothing runs yet
@@ -587,6 +636,7 @@ def run_sweep(scene: str | Path, grid: dict[str, list] | None, out: str | Path, 
             if rows[i] is None:
                 rows[i] = _row(case, "interrupted", None)
         write_summary(out, rows, keys, title())
+        _remove_checkpoint_folder(out)
         if bar is not None:
             bar.close()
 
@@ -606,23 +656,35 @@ def run_sweep(scene: str | Path, grid: dict[str, list] | None, out: str | Path, 
     pending: dict = {}
     try:
         if todo:
-            task = ray.remote(num_cpus=1, max_retries=0)(run_case)
+            # max_retries: system failures only (the worker process died); the simulation's
+            # own exceptions come back as failed records
+            task = ray.remote(num_cpus=1, max_retries=retries)(run_case)
             limit = workers or len(todo)
             queue = list(todo)
+            every = None if math.isinf(checkpoint_every) else float(checkpoint_every)
             while queue or pending:
                 while queue and len(pending) < limit:
                     i = queue.pop(0)
-                    pending[task.remote(prepared[i]["scene"])] = i
+                    path = None if every is None else str(_checkpoint_file(out, prepared[i]))
+                    pending[task.remote(prepared[i]["scene"], path,
+                                        every or DEFAULT_EVERY_S)] = i
                 done, _ = ray.wait(list(pending), num_returns=1)
                 for ref in done:
                     i = pending.pop(ref)
+                    crashed = False
                     try:
                         rec = ray.get(ref)
                     except ray.exceptions.RayError as exc:    # worker crash, lost node, ...
+                        crashed = True
                         rec = {"status": "failed", "error_type": type(exc).__name__,
-                               "error": _one_line(exc), "wall_s": None, "n_steps": None,
+                               "error": f"the case's worker process died ({retries} "
+                                        f"retr{'y' if retries == 1 else 'ies'} allowed, "
+                                        f"--retries): {_one_line(exc)}",
+                               "wall_s": None, "n_steps": None,
                                "outcomes": {}, "stats": {}, "result": None}
                     _write_case(out, prepared[i], rec, plots)
+                    if not crashed:           # a re-run resumes a crashed case's checkpoint
+                        _remove_checkpoint(out, prepared[i])
                     rows[i] = _row(prepared[i], rec["status"], rec)
                     if rec["status"] == "failed":
                         counts["failed"] += 1
@@ -649,4 +711,4 @@ def run_sweep(scene: str | Path, grid: dict[str, list] | None, out: str | Path, 
 
 __all__ = ["run_sweep", "parse_grid", "grid_cases", "case_name", "prepare_cases", "run_case",
            "scalar_outcomes", "rigid_tip_deviation", "write_summary", "completed_case",
-           "SweepError", "STATUSES"]
+           "scene_fingerprint", "SweepError", "STATUSES", "DEFAULT_RETRIES"]

@@ -12,6 +12,7 @@ import time
 import numpy as np
 from scipy.integrate import BDF, RK45
 
+from sim_core.checkpoint import object_state, restore_object_state
 from sim_core.errors import ElementEvaluationError, SimulationError, StalledIntegration
 from sim_core.integrate import _generalized_alpha_numba as ga_numba
 from sim_core.integrate.bdf import (
@@ -184,7 +185,7 @@ class StallMonitor:
             mean_step=mean, window=n, step=solver.t - solver.t_old, last_state=solver.y)
 
 
-def integrate(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
+def integrate(model, y0: np.ndarray, t_end: float, sol: dict, progress=None, checkpoint=None):
     """Integrate model.rhs from t = 0 with dense output at ``sol["n_output"]`` equally spaced
     times.  ``sol["method"]``:
 
@@ -214,12 +215,19 @@ def integrate(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
     budgeted, stalled or interrupted run still yields a partial result.  The statistics
     include rtol, atol, the shortest mean step over the stall monitor's window and, for a
     :class:`sim_core.model.model.Model`, its element worker's governor
-    (:meth:`sim_core.model.workers.Governor.summary`)."""
+    (:meth:`sim_core.model.workers.Governor.summary`).
+
+    ``checkpoint``: a :class:`sim_core.checkpoint.Checkpointer` or None.  Where it holds a
+    checkpoint of this path the run continues from it (:func:`_restore_scipy`); after every
+    accepted step that is not the last, once its interval is due, the whole state is written
+    (:func:`_scipy_snapshot`: scipy's solver object without its callables, the method
+    switch, the stall monitor, the counters, the outputs so far and the model's warm
+    starts), so a resumed run takes the same steps and its result is bit-identical."""
     method = sol.get("method", "RK45")
     if method not in SOLVER_METHODS:
         raise ValueError(f"solver.method = {method!r}: must be one of {SOLVER_METHODS}")
     if method == "generalized_alpha":
-        return integrate_alpha(model, y0, t_end, sol, progress)
+        return integrate_alpha(model, y0, t_end, sol, progress, checkpoint)
     t_eval = np.linspace(0.0, t_end, sol["n_output"])
     rhs = _CountingRHS(model)
     kwargs = {"max_step": sol["max_step"]} if "max_step" in sol else {}
@@ -242,7 +250,12 @@ def integrate(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
             return s
         return cls(rhs, t0, y, t_end, **tol, **kwargs)
 
-    solver = make(BDF if method == "BDF" else RK45, 0.0, y0)
+    saved = checkpoint.take("scipy") if checkpoint is not None else None
+    if saved is None:
+        solver = make(BDF if method == "BDF" else RK45, 0.0, y0)
+    else:                     # a fresh solver of the saved class; its state follows below
+        solver = make(BDF if saved["solver_class"] == "BDF" else RK45, saved["solver"]["t"],
+                      np.array(saved["solver"]["y"], dtype=float))
     # at a BDF stretch's end a fresh Jacobian tells whether RK45 could take BDF's steps; where
     # it costs less than the RK45 trial it replaces (~100 evaluations): the structured one
     # (through the stretch's RefreshedJacobian: its friction columns refreshed, where the
@@ -261,6 +274,17 @@ def integrate(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
     k_out = 1
     stall = StallMonitor(t_end, sol.get("stall_window"), sol.get("stall_max_steps"), budget,
                          wall0)
+    if saved is not None:
+        ys, k_out, steps, njev = list(saved["ys"]), int(saved["k_out"]), list(saved["steps"]), \
+            int(saved["njev"])
+        wall0 = time.perf_counter() - float(saved["wall_s"])
+        _restore_scipy(saved, solver, stretch.get("jac") if isinstance(solver, BDF) else None,
+                       switch, stall, rhs, model, wall0)
+
+    def snapshot():
+        return _scipy_snapshot(solver, stretch.get("jac") if isinstance(solver, BDF) else None,
+                               switch, stall, rhs, model, ys, k_out, steps, njev,
+                               time.perf_counter() - wall0)
 
     def stats():
         wall = time.perf_counter() - wall0
@@ -293,6 +317,8 @@ def integrate(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
             out["n_rk45_kept"] = switch.kept_rk45   # stiffness alarms outside the friction band
             out["first_switch_to_bdf_s"] = switch.switches[0][0] if switch.switches else -1.0
             out["last_switch_s"] = switch.switches[-1][0] if switch.switches else -1.0
+        if checkpoint is not None:
+            out.update(checkpoint.stats())
         return out
 
     try:
@@ -330,6 +356,8 @@ def integrate(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
                 solver = switch.after_step(solver, make)
                 if solver is not old:
                     njev += int(getattr(old, "njev", 0))
+            if checkpoint is not None and solver.status == "running" and checkpoint.due():
+                checkpoint.save("scipy", solver.t, snapshot())
     except KeyboardInterrupt:              # Ctrl-C keeps what was computed, like a budget
         exc = SimulationError(solver.t, "interrupted by the user (KeyboardInterrupt)",
                               step=solver.step_size, last_state=solver.y)
@@ -340,6 +368,86 @@ def integrate(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
         exc.partial = (t_eval[:len(ys)], np.array(ys), stats())
         raise
     return t_eval[:len(ys)], np.array(ys), stats()
+
+
+# -- checkpoints (sim_core.checkpoint) -------------------------------------------------------
+
+def warm_starts(model) -> dict:
+    """The model's state between right-hand sides that the next one starts from: the
+    multiplier Newton's last solution (``Model._multiplier_newton``) and every multiplier
+    force's warm start (the friction regions' micro-motions, ``ContactFriction._x0``).  The
+    converged values depend on them only to the Newton's stopping error, but a bit-identical
+    resume needs them."""
+    out = {"g": getattr(model, "__dict__", {}).get("_g_warm")}
+    for k, mf in enumerate(getattr(model, "multiplier_forces", ())):
+        if hasattr(mf, "_x0"):
+            out[f"x0_{k}"] = mf._x0
+    return out
+
+
+def restore_warm_starts(model, warm: dict) -> None:
+    """Put back :func:`warm_starts`."""
+    if hasattr(model, "__dict__"):
+        if warm.get("g") is None:
+            model.__dict__.pop("_g_warm", None)
+        else:
+            model.__dict__["_g_warm"] = warm["g"]
+    for k, mf in enumerate(getattr(model, "multiplier_forces", ())):
+        if f"x0_{k}" in warm:
+            mf._x0 = dict(warm[f"x0_{k}"])
+
+
+_RHS_SKIP = ("model",)
+_SWITCH_SKIP = ("rhs", "fresh_jacobian", "stiff_friction", "detector")
+_JAC_SKIP = ("rhs", "solver", "cols")
+
+
+def _stall_state(stall: StallMonitor) -> dict:
+    """A stall monitor's window, its wall clocks relative to the run's start."""
+    return {"times": stall.times, "walls": stall.walls - stall.wall0, "k": stall.k,
+            "slowest": stall.slowest}
+
+
+def _restore_stall(stall: StallMonitor, st: dict, wall0: float) -> None:
+    """Put back :func:`_stall_state` for a run whose wall clock starts at ``wall0``."""
+    stall.times[:] = st["times"]
+    stall.walls[:] = st["walls"] + wall0
+    stall.wall0, stall.k, stall.slowest = wall0, int(st["k"]), st["slowest"]
+
+
+def _scipy_snapshot(solver, jac, switch, stall, rhs, model, ys, k_out, steps, njev,
+                    wall_s) -> dict:
+    """The state of :func:`integrate` after an accepted step (a checkpoint's body): scipy's
+    solver without its callables (t, y, step size, error history; RK45's stages and last
+    derivative; BDF's difference array, order, Jacobian, its LU and Newton tolerance), the
+    BDF stretch's :class:`RefreshedJacobian`, the :class:`MethodSwitch` with its detector,
+    the stall monitor's window (wall clocks relative to the run's start), the counters, the
+    outputs so far and the model's warm starts."""
+    return {"solver_class": "BDF" if isinstance(solver, BDF) else "RK45",
+            "solver": object_state(solver, ("I",)),      # BDF's identity: the fresh one's
+            "jac": object_state(jac, _JAC_SKIP) if jac is not None else None,
+            "switch": None if switch is None else {
+                **object_state(switch, _SWITCH_SKIP), "detector": vars(switch.detector)},
+            "stall": _stall_state(stall),
+            "rhs": object_state(rhs, _RHS_SKIP), "warm": warm_starts(model),
+            "ys": np.array(ys), "k_out": k_out, "steps": list(steps), "njev": njev,
+            "wall_s": wall_s}
+
+
+def _restore_scipy(saved: dict, solver, jac, switch, stall, rhs, model, wall0: float) -> None:
+    """Put a :func:`_scipy_snapshot` back onto fresh objects (the solver made at the saved t
+    and y, whose own callables stay).  The counters and warm starts go last: building the
+    fresh solver evaluated the model."""
+    restore_object_state(solver, saved["solver"])
+    if jac is not None and saved["jac"] is not None:
+        restore_object_state(jac, saved["jac"])
+    if switch is not None and saved["switch"] is not None:
+        st = dict(saved["switch"])
+        restore_object_state(switch.detector, st.pop("detector"))
+        restore_object_state(switch, st)
+    _restore_stall(stall, saved["stall"], wall0)
+    restore_object_state(rhs, saved["rhs"])
+    restore_warm_starts(model, saved["warm"])
 
 
 def run_with_partial(integrate, collect, check=None):
@@ -381,7 +489,8 @@ class StructuredTangent:
         return -M @ J[n:, :n], -M @ J[n:, n:]
 
 
-def integrate_alpha(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
+def integrate_alpha(model, y0: np.ndarray, t_end: float, sol: dict, progress=None,
+                    checkpoint=None):
     """Generalized-alpha (Chung & Hulbert 1993; Arnold & Bruels 2007) from y0 = (z0, z_dot0)
     at t = 0 with outputs at ``sol["n_output"]`` equally spaced times; the contract of
     :func:`integrate`.  Solver keys: ``rho_inf`` (spectral radius at infinity, [0, 1]),
@@ -398,14 +507,22 @@ def integrate_alpha(model, y0: np.ndarray, t_end: float, sol: dict, progress=Non
     (:func:`integrate_generalized_alpha`) with the structured tangent.  The wall budget
     ``max_wall_s`` and the progress callback are served between compiled calls (or after
     every numpy step); a failed Newton iteration, a step below its floor, a stall or the
-    budget raise SimulationError (StalledIntegration for a stall) with the outputs so far."""
+    budget raise SimulationError (StalledIntegration for a stall) with the outputs so far.
+
+    ``checkpoint`` (:class:`sim_core.checkpoint.Checkpointer` or None): the compiled paths
+    write the whole loop state between compiled calls (accelerations, auxiliary
+    accelerations, iteration matrix, tangent, step controller, counters, outputs), the numpy
+    path after accepted steps (:func:`integrate_generalized_alpha`'s ``checkpoint``), and both
+    resume from it bit-identically."""
     if sol.get("h") is None:
-        return _alpha_adaptive(model, y0, t_end, sol, progress)
-    return _alpha_fixed(model, y0, t_end, sol, progress)
+        return _alpha_adaptive(model, y0, t_end, sol, progress, checkpoint)
+    return _alpha_fixed(model, y0, t_end, sol, progress, checkpoint)
 
 
-def _alpha_fixed(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
-    """Generalized-alpha at the fixed step ``sol["h"]`` (:func:`integrate_alpha`)."""
+def _alpha_fixed(model, y0: np.ndarray, t_end: float, sol: dict, progress=None,
+                 checkpoint=None):
+    """Generalized-alpha at the fixed step ``sol["h"]`` (:func:`integrate_alpha`); checkpoints
+    after whole output intervals."""
     n = model.n_dof
     t_eval = np.linspace(0.0, t_end, sol["n_output"])
     h, rho = float(sol["h"]), float(sol.get("rho_inf", 0.9))
@@ -426,7 +543,8 @@ def _alpha_fixed(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
                 "min_step_s": min(h_used) if h_used else h, "max_step_s": max(h_used) if h_used else h,
                 "method": "generalized_alpha", "rho_inf": rho, "h": h,
                 "newton_atol": newton_atol, "compiled": plan is not None,
-                "real_time_factor": float(t_eval[len(ys) - 1]) / max(wall, 1e-12)}
+                "real_time_factor": float(t_eval[len(ys) - 1]) / max(wall, 1e-12),
+                **(checkpoint.stats() if checkpoint is not None else {})}
 
     def fail(t, reason, step):
         exc = SimulationError(t, reason, step=step, last_state=ys[-1])
@@ -434,12 +552,32 @@ def _alpha_fixed(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
         return exc
 
     if plan is None:
+        saved = checkpoint.take("alpha_numpy_fixed") if checkpoint is not None else None
+        if saved is not None:
+            wall0 = time.perf_counter() - float(saved["wall_s"])
+
+        def hook(get):
+            if checkpoint.due():
+                st = get()
+                checkpoint.save("alpha_numpy_fixed", float(st["ga"]["t"]), {
+                    "ga": st, "warm": warm_starts(model), "wall_s": time.perf_counter() - wall0})
+
+        def each_step(t, hh, q, v):        # the wall budget after every step
+            if budget is not None and t < t_end and time.perf_counter() - wall0 > budget:
+                raise SimulationError(t, f"wall-clock budget solver.max_wall_s = {budget:g} s "
+                                      "exhausted", step=hh, last_state=np.concatenate([q, v]))
+
         try:
-            r = integrate_generalized_alpha(StructuredTangent(model), (0.0, t_end), y0[:n],
-                                            y0[n:], h=h, rho_inf=rho, atol=newton_atol,
-                                            t_eval=t_eval)
+            r = integrate_generalized_alpha(
+                StructuredTangent(model), (0.0, t_end), y0[:n], y0[n:], h=h, rho_inf=rho,
+                atol=newton_atol, t_eval=t_eval, callback=each_step,
+                checkpoint=hook if checkpoint is not None else None,
+                resume=saved["ga"] if saved is not None else None,
+                on_resume=(lambda: restore_warm_starts(model, saved["warm"])) if saved else None)
         except SimulationError as exc:
-            exc.partial = (t_eval[:1], np.array(ys), stats())
+            part = getattr(exc, "partial_output", None)       # the outputs reached
+            exc.partial = ((part[0], np.hstack([part[1], part[2]]), stats()) if part is not None
+                           and len(part[0]) else (t_eval[:1], np.array(ys), stats()))
             raise
         st = r.stats
         counts[:] = (st.n_steps, st.n_force_evaluations, st.n_newton_iterations,
@@ -451,28 +589,63 @@ def _alpha_fixed(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
         return t_eval, np.array(ys), stats()
 
     q, v = np.array(y0[:n], dtype=float), np.array(y0[n:], dtype=float)
-    qdd, a = _initial_accelerations(plan, q, v)
-    Sinv, qdd_prev, carry = np.empty((n, n)), qdd.copy(), np.array([0.0, 1.0])
-    out = np.empty((2, n)), np.empty((2, n)), np.empty((2, n))
-    for k in range(1, len(t_eval)):
+    saved = checkpoint.take("alpha_fixed") if checkpoint is not None else None
+    if saved is None:
+        qdd, a = _initial_accelerations(plan, q, v)
+        Sinv, qdd_prev, carry = np.empty((n, n)), qdd.copy(), np.array([0.0, 1.0])
+        out = np.empty((2, n)), np.empty((2, n)), np.empty((2, n))
+        k0 = 1
+    else:                          # the loop state after output interval k0 - 1
+        q, v, qdd, a, Sinv, qdd_prev, carry = (np.array(saved[x], dtype=float) for x in (
+            "q", "v", "qdd", "a", "Sinv", "qdd_prev", "carry"))
+        out = tuple(np.array(x, dtype=float) for x in saved["out"])
+        counts[:] = saved["counts"]
+        ys, h_used, k0 = list(saved["ys"]), list(saved["h_used"]), int(saved["k"])
+        wall0 = time.perf_counter() - float(saved["wall_s"])
+    chunk = 1                  # steps per compiled call, grown to ~0.05 s of wall time
+    for k in range(k0, len(t_eval)):
         span = t_eval[k] - t_eval[k - 1]
         m = max(1, math.ceil(span / h * (1.0 - 1e-12)))
         hh = span / m
         h_used.append(hh)
-        code, done = ga_numba.run_steps(
-            q, v, qdd, a, m, hh, p.alpha_m, p.alpha_f, p.beta, p.gamma, newton_atol, 8, 0.3,
-            REL_STEP, m, 0.0, plan.Qp, plan.rows, plan.sgn, plan.eidx, plan.red, plan.sg,
-            *plan.kernel_args, ec.NO_ACC, *out, counts, Sinv, qdd_prev, carry)
-        if code != ga_numba.OK or not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
-            raise fail(float(t_eval[k - 1] + done * hh), "generalized-alpha: the Newton "
-                       "iteration failed with a fresh tangent (or the state is not finite); "
-                       "reduce solver.h", hh)
+        # the interval's m steps in calls of ``chunk`` steps, sized to ~0.05 s of wall time,
+        # so the budget is served within an interval too (the loop state carries over from
+        # call to call: the steps are those of one call)
+        i = 0
+        while i < m:
+            c = min(m - i, chunk)
+            tic = time.perf_counter()
+            try:
+                code, done = ga_numba.run_steps(
+                    q, v, qdd, a, c, hh, p.alpha_m, p.alpha_f, p.beta, p.gamma, newton_atol, 8,
+                    0.3, REL_STEP, c, 0.0, plan.Qp, plan.rows, plan.sgn, plan.eidx, plan.red,
+                    plan.sg, *plan.kernel_args, ec.NO_ACC, *out, counts, Sinv, qdd_prev, carry)
+            except _KERNEL_ERRORS as exc:
+                raise fail(float(t_eval[k - 1] + i * hh), "generalized-alpha: the element "
+                           f"evaluation failed ({type(exc).__name__}: {exc}); reduce solver.h",
+                           hh) from None
+            if code != ga_numba.OK or not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
+                raise fail(float(t_eval[k - 1] + (i + done) * hh), "generalized-alpha: the "
+                           "Newton iteration failed with a fresh tangent (or the state is not "
+                           "finite); reduce solver.h", hh)
+            i += c
+            chunk = max(1, min(10 ** 6, int(0.05 * c / max(time.perf_counter() - tic, 1e-9))))
+            if budget is not None and i < m and time.perf_counter() - wall0 > budget:
+                exc = fail(float(t_eval[k - 1] + i * hh), "wall-clock budget solver.max_wall_s "
+                           f"= {budget:g} s exhausted", hh)
+                exc.last_state = np.concatenate([q, v])
+                raise exc
         ys.append(np.concatenate([q, v]))
         if progress is not None:
             progress(float(t_eval[k]), time.perf_counter() - wall0)
         if budget is not None and time.perf_counter() - wall0 > budget and k < len(t_eval) - 1:
             raise fail(float(t_eval[k]), f"wall-clock budget solver.max_wall_s = {budget:g} s "
                        "exhausted", hh)
+        if checkpoint is not None and k < len(t_eval) - 1 and checkpoint.due():
+            checkpoint.save("alpha_fixed", float(t_eval[k]), {
+                "q": q, "v": v, "qdd": qdd, "a": a, "Sinv": Sinv, "qdd_prev": qdd_prev,
+                "carry": carry, "out": out, "counts": counts, "ys": np.array(ys),
+                "h_used": list(h_used), "k": k + 1, "wall_s": time.perf_counter() - wall0})
     return t_eval, np.array(ys), stats()
 
 
@@ -511,7 +684,8 @@ ALPHA_SAFETY, ALPHA_FAC_MIN, ALPHA_FAC_MAX = 0.9, 0.2, 5.0
 ALPHA_FLOOR = 1e-12          # smallest step / t_end
 
 
-def _alpha_adaptive(model, y0: np.ndarray, t_end: float, sol: dict, progress=None):
+def _alpha_adaptive(model, y0: np.ndarray, t_end: float, sol: dict, progress=None,
+                    checkpoint=None):
     """Error-controlled generalized-alpha (:func:`integrate_alpha` without ``h``).
 
     The local error estimate is the position one of
@@ -537,7 +711,8 @@ def _alpha_adaptive(model, y0: np.ndarray, t_end: float, sol: dict, progress=Non
 
     A step below 1e-12 t_end (``ALPHA_FLOOR``) raises SimulationError; a mean step below
     t_end / ``stall_max_steps`` (1e6) over 1000 accepted steps raises StalledIntegration
-    (the rule of :class:`StallMonitor`); calls return every 1000 steps for the budget."""
+    (the rule of :class:`StallMonitor`); calls return every 1000 steps for the budget and
+    the checkpoints."""
     n = model.n_dof
     t_eval = np.linspace(0.0, t_end, sol["n_output"])
     rho = float(sol.get("rho_inf", 0.9))
@@ -572,6 +747,8 @@ def _alpha_adaptive(model, y0: np.ndarray, t_end: float, sol: dict, progress=Non
                "real_time_factor": float(hs[0]) / max(wall, 1e-12)}
         if math.isfinite(pace.slowest):
             out["min_window_mean_step_s"] = float(pace.slowest)
+        if checkpoint is not None:
+            out.update(checkpoint.stats())
         return out
 
     def fail(reason, step, cls=SimulationError, **kw):
@@ -586,7 +763,7 @@ def _alpha_adaptive(model, y0: np.ndarray, t_end: float, sol: dict, progress=Non
 
     if plan is None:
         return _alpha_adaptive_numpy(model, y0, t_end, sol, progress, t_eval, p, rtol, atol,
-                                     h_max, h_min, budget, window, wall0)
+                                     h_max, h_min, budget, window, wall0, checkpoint)
 
     q, v = np.array(y0[:n], dtype=float), np.array(y0[n:], dtype=float)
     qdd, a = _initial_accelerations(plan, q, v)
@@ -596,14 +773,29 @@ def _alpha_adaptive(model, y0: np.ndarray, t_end: float, sol: dict, progress=Non
                            (p.error_constant * acc) ** -0.5 if acc > 0 else t_end))
     Mr, Kr, Cr, Sinv = (np.empty((n, n)) for _ in range(4))
     carry = np.array([0.0, 1.0, 0.0])
+    saved = checkpoint.take("alpha_adaptive") if checkpoint is not None else None
+    if saved is not None:          # the loop state after a compiled call
+        for name, arr in (("q", q), ("v", v), ("qdd", qdd), ("a", a), ("hs", hs), ("Y", Y),
+                          ("counts", counts), ("Mr", Mr), ("Kr", Kr), ("Cr", Cr),
+                          ("Sinv", Sinv), ("carry", carry)):
+            arr[...] = saved[name]
+        k_out = int(saved["k_out"])
+        state["y"] = np.concatenate([q, v])
+        pace.marks, pace.slowest = [tuple(m) for m in saved["pace_marks"]], saved["pace_slowest"]
+        wall0 = time.perf_counter() - float(saved["wall_s"])
     try:
         while True:
-            code, k_out = ga_numba.run_adaptive(
-                q, v, qdd, a, hs, t_eval, k_out, window, p.alpha_m, p.alpha_f, p.beta, p.gamma,
-                p.error_constant, rtol, atol, ALPHA_SAFETY, ALPHA_FAC_MIN, ALPHA_FAC_MAX, h_min,
-                h_max, t_end, newton_atol, 8, 0.3, REL_STEP, plan.Qp, plan.rows, plan.sgn,
-                plan.eidx, plan.red, plan.sg, *plan.kernel_args, ec.NO_ACC, Y, counts, Mr, Kr,
-                Cr, Sinv, carry)
+            try:
+                code, k_out = ga_numba.run_adaptive(
+                    q, v, qdd, a, hs, t_eval, k_out, window, p.alpha_m, p.alpha_f, p.beta,
+                    p.gamma, p.error_constant, rtol, atol, ALPHA_SAFETY, ALPHA_FAC_MIN,
+                    ALPHA_FAC_MAX, h_min, h_max, t_end, newton_atol, 8, 0.3, REL_STEP, plan.Qp,
+                    plan.rows, plan.sgn, plan.eidx, plan.red, plan.sg, *plan.kernel_args,
+                    ec.NO_ACC, Y, counts, Mr, Kr, Cr, Sinv, carry)
+            except _KERNEL_ERRORS as exc:
+                raise fail(f"generalized-alpha: the element evaluation failed "
+                           f"({type(exc).__name__}: {exc}); tighten solver.rtol/atol",
+                           float(hs[1])) from None
             state["y"] = np.concatenate([q, v])
             if code == ga_numba.NEWTON_FAILED:
                 raise fail("generalized-alpha: the state is not finite after a converged "
@@ -619,6 +811,12 @@ def _alpha_adaptive(model, y0: np.ndarray, t_end: float, sol: dict, progress=Non
             if code == ga_numba.OK:
                 break
             check_budget()
+            if checkpoint is not None and checkpoint.due():
+                checkpoint.save("alpha_adaptive", float(hs[0]), {
+                    "q": q, "v": v, "qdd": qdd, "a": a, "hs": hs, "Y": Y, "counts": counts,
+                    "Mr": Mr, "Kr": Kr, "Cr": Cr, "Sinv": Sinv, "carry": carry,
+                    "k_out": k_out, "pace_marks": list(pace.marks),
+                    "pace_slowest": pace.slowest, "wall_s": time.perf_counter() - wall0})
     except StalledIntegration as exc:
         exc.partial = (t_eval[:k_out], Y[:k_out].copy(), stats())
         raise
@@ -628,14 +826,28 @@ def _alpha_adaptive(model, y0: np.ndarray, t_end: float, sol: dict, progress=Non
 
 
 def _alpha_adaptive_numpy(model, y0, t_end, sol, progress, t_eval, p, rtol, atol, h_max,
-                          h_min, budget, window, wall0):
+                          h_min, budget, window, wall0, checkpoint=None):
     """The numpy path of :func:`_alpha_adaptive`: :func:`integrate_generalized_alpha` with the
     structured tangent, the position estimate and the same floor; the stall monitor, the
-    budget and the progress callback after every accepted step."""
+    budget, the progress callback and the checkpoints after every accepted step."""
     n = model.n_dof
     stall = StallMonitor(t_end, window, sol.get("stall_max_steps"), budget, wall0)
     shim = type("Step", (), {})()
     shim.t = shim.t_old = 0.0
+    saved = checkpoint.take("alpha_numpy_adaptive") if checkpoint is not None else None
+    if saved is not None:
+        wall0 = time.perf_counter() - float(saved["wall_s"])
+        _restore_stall(stall, saved["stall"], wall0)
+        shim.t, shim.t_old = saved["shim"]
+        shim.y = np.array(saved["shim_y"], dtype=float)
+
+    def hook(get):
+        if checkpoint.due():
+            st = get()
+            checkpoint.save("alpha_numpy_adaptive", float(st["ga"]["t"]), {
+                "ga": st, "stall": _stall_state(stall), "shim": (shim.t, shim.t_old),
+                "shim_y": shim.y, "warm": warm_starts(model),
+                "wall_s": time.perf_counter() - wall0})
 
     def each_step(t, h, q, v):
         shim.t_old, shim.t, shim.y = shim.t, t, np.concatenate([q, v])
@@ -663,6 +875,8 @@ def _alpha_adaptive_numpy(model, y0, t_end, sol, progress, t_eval, p, rtol, atol
                "real_time_factor": float(shim.t) / max(wall, 1e-12)}
         if math.isfinite(stall.slowest):
             out["min_window_mean_step_s"] = float(stall.slowest)
+        if checkpoint is not None:
+            out.update(checkpoint.stats())
         return out
 
     try:
@@ -670,7 +884,10 @@ def _alpha_adaptive_numpy(model, y0, t_end, sol, progress, t_eval, p, rtol, atol
             StructuredTangent(model), (0.0, t_end), y0[:n], y0[n:], rho_inf=p.rho_inf,
             rtol=rtol, atol=atol, t_eval=t_eval, h_min=h_min, h_max=h_max,
             max_steps=2 ** 62, safety=ALPHA_SAFETY, fac_min=ALPHA_FAC_MIN,
-            fac_max=ALPHA_FAC_MAX, error_estimate="position", callback=each_step)
+            fac_max=ALPHA_FAC_MAX, error_estimate="position", callback=each_step,
+            checkpoint=hook if checkpoint is not None else None,
+            resume=saved["ga"] if saved is not None else None,
+            on_resume=(lambda: restore_warm_starts(model, saved["warm"])) if saved else None)
     except (SimulationError, KeyboardInterrupt) as exc:
         ts, q, v, _ = getattr(exc, "partial_output", (t_eval[:1], y0[None, :n], y0[None, n:], None))
         st = getattr(exc, "partial_stats", None)
@@ -692,10 +909,23 @@ def _initial_accelerations(plan, q, v):
     the plan's constant selecting constraints, and the auxiliary acceleration a_0 = z_ddot(0)
     (Arnold & Bruels 2007)."""
     n = len(q)
-    M0, _, _, f0 = ga_numba.mass_tangent(*_lifted(plan, q, v, np.zeros(n)), REL_STEP, plan.eidx,
-                                         plan.red, plan.sg, n, *plan.kernel_args, ec.NO_ACC)
-    qdd = np.linalg.solve(M0, f0)
+    try:
+        M0, _, _, f0 = ga_numba.mass_tangent(*_lifted(plan, q, v, np.zeros(n)), REL_STEP,
+                                             plan.eidx, plan.red, plan.sg, n, *plan.kernel_args,
+                                             ec.NO_ACC)
+        qdd = np.linalg.solve(M0, f0)
+    except _KERNEL_ERRORS as exc:          # a degenerate element at the initial state
+        raise ElementEvaluationError(0.0, f"initial accelerations: {type(exc).__name__}: "
+                                     f"{exc}", last_state=np.concatenate([q, v])) from None
+    if not np.all(np.isfinite(qdd)):
+        raise ElementEvaluationError(0.0, "initial accelerations: not finite",
+                                     last_state=np.concatenate([q, v]))
     return qdd, qdd.copy()
+
+
+# what a compiled element kernel raises at a degenerate state (an element collapsed to zero
+# length, a singular mass matrix): the compiled loops turn it into a typed SimulationError
+_KERNEL_ERRORS = (ZeroDivisionError, OverflowError, FloatingPointError, np.linalg.LinAlgError)
 
 
 def _lifted(plan, z, zd, zdd):

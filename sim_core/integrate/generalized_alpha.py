@@ -62,7 +62,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from typing import Callable, Sequence
 
 import numpy as np
@@ -532,7 +532,9 @@ def integrate_generalized_alpha(
         max_newton_failures: int = 10, safety: float = 0.9, fac_min: float = 0.2,
         fac_max: float = 5.0, fd_rel_step: float | None = None,
         error_estimate: str = "position_velocity",
-        callback: Callable[[float, float, np.ndarray, np.ndarray], None] | None = None
+        callback: Callable[[float, float, np.ndarray, np.ndarray], None] | None = None,
+        checkpoint: Callable[[Callable[[], dict]], None] | None = None,
+        resume: dict | None = None, on_resume: Callable[[], None] | None = None
         ) -> IntegrationResult:
     """Integrate ``M(q) q̈ = f(t, q, v)`` with the generalized-α method.
 
@@ -563,6 +565,15 @@ def integrate_generalized_alpha(
         (e_q over the n coordinates, Zienkiewicz & Xie 1991); module doc.
     callback : called as ``callback(t, h, q, v)`` after every accepted step (s, s, state);
         it may raise SimulationError (a wall-clock budget, a stall), which ends the run.
+    checkpoint : called as ``checkpoint(state)`` after every accepted step (after
+        ``callback``) that is not the last; ``state()`` returns the whole integration state
+        (:func:`_loop_state`: the method's state, Jacobian and LU cache, statistics, outputs
+        so far and the step loop's controller memory: numbers, lists, tuples, dicts and
+        arrays only), for a checkpoint file.
+    resume : such a state: the integration continues from it and takes the steps the
+        uninterrupted run takes (bit-identical outputs); ``on_resume()`` is called once it
+        is restored, before the first step (the caller puts back what the restored
+        construction's model evaluation changed, e.g. the model's warm starts).
 
     A SimulationError (or KeyboardInterrupt) raised during the steps carries the outputs
     reached so far as
@@ -599,16 +610,21 @@ def integrate_generalized_alpha(
         raise ValueError(f"error_estimate = {error_estimate!r}: 'position_velocity' or 'position'")
     ga.position_only = error_estimate == "position"
     out = _Output(te, t0, ga.state)
+    loop = None
+    if resume is not None:
+        loop = _restore_loop_state(resume, ga, out, stats)
+        if on_resume is not None:
+            on_resume()
     try:
         if h is not None:
-            _run_fixed(ga, out, t1, float(h), jac_refresh_rate, callback)
+            _run_fixed(ga, out, t1, float(h), jac_refresh_rate, callback, checkpoint, loop)
         else:
             span = t1 - t0
             h_min = max(10 * _EPS * max(abs(t0), abs(t1)), 1e-12 * span) if h_min is None else h_min
             h_max = span if h_max is None else min(h_max, span)
             ctl = _Controller(safety, fac_min, fac_max, h_min, h_max, max_steps,
                               max_newton_failures, jac_refresh_rate, refresh_on_reject)
-            _run_adaptive(ga, out, t1, ctl, h0, callback)
+            _run_adaptive(ga, out, t1, ctl, h0, callback, checkpoint, loop)
     except (SimulationError, KeyboardInterrupt) as exc:
         stats.n_force_evaluations = ev.n_calls
         exc.partial_output = out.arrays(n)
@@ -619,6 +635,32 @@ def integrate_generalized_alpha(
     return IntegrationResult(ts, q, v, a, stats)
 
 
+_GA_SKIP = ("ev", "p", "stats")
+
+
+def _loop_state(ga: _GeneralizedAlpha, out: _Output, loop: dict) -> dict:
+    """The whole state of a step loop after an accepted step: the method's numbers and arrays
+    (state, accelerations, auxiliary accelerations, Jacobian, LU cache, Newton rate memory),
+    the evaluation counters, the statistics, the outputs so far and the loop's own memory
+    ``loop`` (step controller)."""
+    return {"ga": {k: v for k, v in vars(ga).items() if k not in _GA_SKIP},
+            "ev": {"n_calls": ga.ev.n_calls, "n_tangent": ga.ev.n_tangent},
+            "stats": asdict(ga.stats), "out": {"ts": list(out.ts), "ys": list(out.ys),
+                                               "k": out.k}, "loop": dict(loop)}
+
+
+def _restore_loop_state(state: dict, ga: _GeneralizedAlpha, out: _Output,
+                        stats: IntegrationStats) -> dict:
+    """Put a :func:`_loop_state` back onto fresh objects; returns the loop's memory."""
+    for k, v in state["ga"].items():
+        setattr(ga, k, v)
+    ga.ev.n_calls, ga.ev.n_tangent = state["ev"]["n_calls"], state["ev"]["n_tangent"]
+    for k, v in state["stats"].items():
+        setattr(stats, k, v)
+    out.ts, out.ys, out.k = list(state["out"]["ts"]), list(state["out"]["ys"]), state["out"]["k"]
+    return dict(state["loop"])
+
+
 def _record_step(stats: IntegrationStats, h: float) -> None:
     stats.n_steps += 1
     stats.min_step = h if not stats.min_step <= h else stats.min_step
@@ -626,14 +668,21 @@ def _record_step(stats: IntegrationStats, h: float) -> None:
 
 
 def _run_fixed(ga: _GeneralizedAlpha, out: _Output, t1: float, h_req: float,
-               jac_refresh_rate: float, callback=None) -> None:
-    """Fixed-step mode: N = ceil(span/h) equal steps, Newton failure or NaN -> SimulationError."""
+               jac_refresh_rate: float, callback=None, checkpoint=None,
+               loop: dict | None = None) -> None:
+    """Fixed-step mode: N = ceil(span/h) equal steps, Newton failure or NaN -> SimulationError.
+    ``checkpoint``, ``loop``: :func:`integrate_generalized_alpha`'s checkpoint hook and the
+    restored loop memory (the grid's start, step count and the next step's index)."""
     if not h_req > 0:
         raise ValueError(f"fixed step h must be positive, got {h_req}")
-    t0 = ga.t
-    n_steps = max(1, math.ceil((t1 - t0) / h_req * (1.0 - 1e-12)))
+    if loop is None:
+        t0 = ga.t
+        n_steps = max(1, math.ceil((t1 - t0) / h_req * (1.0 - 1e-12)))
+        i0 = 0
+    else:
+        t0, n_steps, i0 = loop["t0"], loop["n_steps"], loop["i"]
     h = (t1 - t0) / n_steps
-    for i in range(n_steps):
+    for i in range(i0, n_steps):
         if ga.K is None:
             ga.ensure_base()
             _jac(ga, h)
@@ -655,6 +704,8 @@ def _run_fixed(ga: _GeneralizedAlpha, out: _Output, t1: float, h_req: float,
             ga.invalidate_jacobian()
         if callback is not None:
             callback(ga.t, h, ga.q, ga.v)
+        if checkpoint is not None and i < n_steps - 1:
+            checkpoint(lambda: _loop_state(ga, out, {"t0": t0, "n_steps": n_steps, "i": i + 1}))
 
 
 def _jac(ga: _GeneralizedAlpha, h: float) -> None:
@@ -696,17 +747,24 @@ class _Controller:
 
 
 def _run_adaptive(ga: _GeneralizedAlpha, out: _Output, t1: float, ctl: _Controller,
-                  h0: float | None, callback=None) -> None:
+                  h0: float | None, callback=None, checkpoint=None,
+                  loop: dict | None = None) -> None:
     """Adaptive mode: error test on (e_q, e_v) (module doc), rejection, Newton-failure cuts
     (×1/4), Jacobian refresh on Newton failure / slow contraction / rejection.  Controller
     and starting step after Hairer, Nørsett & Wanner, Solving ODEs I, Sect. II.4, with the
-    RADAU5 refinements of Hairer & Wanner, Solving ODEs II, Sect. IV.8."""
+    RADAU5 refinements of Hairer & Wanner, Solving ODEs II, Sect. IV.8.  ``checkpoint``,
+    ``loop``: :func:`integrate_generalized_alpha`'s checkpoint hook and the restored loop
+    memory (next step, failure count, rejection flag, predictive controller's memory)."""
     stats = ga.stats
-    h = _initial_step(ga, t1 - ga.t, ctl.h_max) if h0 is None else float(h0)
-    h = min(max(h, ctl.h_min), ctl.h_max)
-    failures = 0
-    rejected_last = False
-    h_old = err_old = None                  # last accepted step and its error (predictive control)
+    if loop is None:
+        h = _initial_step(ga, t1 - ga.t, ctl.h_max) if h0 is None else float(h0)
+        h = min(max(h, ctl.h_min), ctl.h_max)
+        failures = 0
+        rejected_last = False
+        h_old = err_old = None              # last accepted step and its error (predictive control)
+    else:
+        h, failures, rejected_last = loop["h"], loop["failures"], loop["rejected_last"]
+        h_old, err_old = loop["h_old"], loop["err_old"]
     while ga.t < t1:
         if stats.n_steps >= ctl.max_steps:
             raise _fail(ga, f"max_steps = {ctl.max_steps} reached", h)
@@ -767,6 +825,10 @@ def _run_adaptive(ga: _GeneralizedAlpha, out: _Output, t1: float, ctl: _Controll
         if h < ctl.floor(ga.t) and ga.t < t1:
             raise _fail(ga, f"step size {h:.3g} s below h_min = {ctl.floor(ga.t):.3g} s "
                         f"(error control)", h)
+        if checkpoint is not None and ga.t < t1:
+            checkpoint(lambda: _loop_state(ga, out, {
+                "h": h, "failures": failures, "rejected_last": rejected_last, "h_old": h_old,
+                "err_old": err_old}))
 
 
 # -- scipy wrapper ---------------------------------------------------------------------------

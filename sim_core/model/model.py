@@ -79,7 +79,7 @@ class Model:
     # the multiplier Newton starts from the last solution (Model._multiplier_newton); False:
     # from g = 0 at every evaluation
     multiplier_warm_start: bool = True
-    baumgarte: tuple[float, float] = (10.0, 10.0)          # xi1, xi2 in 1/s (second seed Eq. 8)
+    baumgarte: tuple[float, float] = (10.0, 10.0)          # xi1, xi2 in 1/s (SIMULTECH 2020 Eq. 8)
     # the saddle-point system by block elimination over the elements' own coordinates
     # (saddle_point.kkt_factor; _block_of: the coordinates shared by two elements, the extra
     # coordinates and the multipliers form the border) where M_r is block-diagonal in them;

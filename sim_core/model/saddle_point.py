@@ -5,7 +5,7 @@
 factored once per right-hand side: by block elimination over the elements' own coordinates
 (compiled in :mod:`sim_core.model._saddle_point_numba`; :func:`kkt_factor_blocks_reference` is
 its numpy reference) where M_r is block-diagonal in them, else by the LU of the whole matrix.
-Second seed Eq. 8 (the index-1 form with Baumgarte's terms in c).
+SIMULTECH 2020 Eq. 8 (the index-1 form with Baumgarte's terms in c).
 """
 
 from __future__ import annotations

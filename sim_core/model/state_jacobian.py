@@ -2,7 +2,7 @@
 
 The integrated system is y = (z, z_dot), y' = (z_dot, z_ddot(t, z, z_dot)), where z_ddot and the
 constraint multipliers lambda solve the index-1 saddle-point system of :class:`sim_core.model.model.
-Model` (constraint rows g(Q) = b(t), Baumgarte terms xi1, xi2; second seed Eq. 8), with the
+Model` (constraint rows g(Q) = b(t), Baumgarte terms xi1, xi2; SIMULTECH 2020 Eq. 8), with the
 multiplier-dependent friction forces of Zhao-Qi-Wang 2024 Section 8.3 in the force vector:
 
     R1 = P^T [ F(Q, Q_dot) + F_mu(Q, Q_dot, lambda) - M(Q) Q_ddot + G(Q)^T lambda ] = 0

@@ -21,7 +21,7 @@ the quadrature points:
 * virtual power of the effects (Eq. 34): inertia M += int rhoA J_r^T J_r + J_w^T J J_w ds,
   F -= int rhoA J_r^T a + J_w^T (J w_dot + omega x J omega) ds; elastic force as the gradient
   of the strain energy (Eqs. 35-36: F -= sum w [l B_xi^T D eps + W dl/dQ]); the stress filter of
-  the second seed (Eq. 53): M += (h^2/6) int B_s^T D B_s ds, F -= int B_s^T D ((h/2) eps_dot +
+  the SIMULTECH 2020 paper (Eq. 53): M += (h^2/6) int B_s^T D B_s ds, F -= int B_s^T D ((h/2) eps_dot +
   (h^2/6) (B_s)^. q_dot) ds; gravity F += int rhoA J_r^T g ds.
 
 With inertia or the filter the kinematics are evaluated once, at the complex-step state: the

@@ -7,7 +7,7 @@ model solves the index-1 form at acceleration level,
     [ C     0   ] [ -lambda] = [ b_ddot - g_QQ[Q_dot, Q_dot] - g_Q Q_ddot_p
                                  - 2 xi1 (g_Q Q_dot - b_dot) - xi2^2 (g - b)    ]
 
-with C = g_Q P (second seed, Eq. 8: Phi_ddot + 2 xi1 Phi_dot + xi2^2 Phi = 0).  The quadratic
+with C = g_Q P (SIMULTECH 2020, Eq. 8: Phi_ddot + 2 xi1 Phi_dot + xi2^2 Phi = 0).  The quadratic
 velocity term g_QQ[Q_dot, Q_dot] is the complex-step derivative of g_Q(Q + i h Q_dot) Q_dot.
 The position-level violation |g - b| is reported as an output so drift is visible.
 

@@ -195,7 +195,7 @@ class CubicSmoothstepSchedule(_PiecewiseProfile):
 
 @dataclass(frozen=True)
 class Eq52Profile(_PiecewiseProfile):
-    """Cubic rise / hold / linear decay of the actuator rate (second seed, Eq. 52).
+    """Cubic rise / hold / linear decay of the actuator rate (SIMULTECH 2020, Eq. 52).
 
     Source: folding long-boom manipulator (SIMULTECH 2020) Eq. 52;
     docs/model.md#input-folding-drive.

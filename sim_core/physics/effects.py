@@ -162,7 +162,7 @@ class Elasticity(Effect):
 
 
 class StressFilter(Effect):
-    """High-frequency filtering of the internal stress (second seed, Eq. 53).
+    """High-frequency filtering of the internal stress (SIMULTECH 2020, Eq. 53).
 
     sigma_bar = sigma + (h/2) sigma_dot + (h^2/6) sigma_ddot with material rates:
     adds (h^2/6) int B_s^T D B_s ds to the mass matrix and the damping-like forces

@@ -4,9 +4,10 @@ that defines ``PLUGIN = EffectPlugin(...)``, plus its module name in :data:`EFFE
 The registration carries everything a scene and a run need from the effect:
 
 * ``name``: the switch ``effects.<name>`` (default false) and the scene table ``[<name>]``;
+* ``fields``: the declared scene table ``[<name>]`` (:class:`sim_core.scene.fields.Table`:
+  every key's type, unit, default, range and note), which the scene reference lists;
 * ``validate(table, scene)``: the resolved table (SceneError naming the key and its range),
-  written with the helpers of :mod:`sim_core.scene.fields` so that the scene reference lists
-  its keys;
+  read through ``fields``;
 * ``build(table, system)``: the :class:`~sim_core.physics.effects.Effect` added to the model
   (``system``: the assembled system, whose model, beams and parameters it may read);
 * ``power(effect, model, t, Q, Qd)``: the power (W) the effect feeds into the system, which
@@ -23,7 +24,7 @@ from __future__ import annotations
 
 import importlib
 from dataclasses import dataclass
-from typing import Callable
+from typing import Any, Callable
 
 __all__ = ["EffectPlugin", "EFFECT_PLUGINS", "effect_plugins"]
 
@@ -43,6 +44,7 @@ class EffectPlugin:
     power: Callable | None = None
     figures: Callable | None = None
     description: str = ""
+    fields: Any = None
 
 
 def effect_plugins() -> dict[str, EffectPlugin]:

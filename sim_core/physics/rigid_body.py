@@ -12,7 +12,7 @@ The first two entries have the meaning of :func:`sim_core.physics.constraints.ma
 existing builders :func:`~sim_core.physics.constraints.point_coincidence` and
 :func:`~sim_core.physics.constraints.distance_driver` accept frame functions (they read only r, J).
 All functions are complex-step safe in Q (the model forms the quadratic velocity terms by a
-complex-step directional derivative of the Jacobians, second seed Eq. 8 right-hand side).
+complex-step directional derivative of the Jacobians, SIMULTECH 2020 Eq. 8 right-hand side).
 
 Rigid bodies in a slewing plane (reduced parametrization)
 ---------------------------------------------------------

@@ -31,9 +31,9 @@ import numpy as np
 from sim_core.errors import SceneError
 from sim_core.physics.effects import Effect, _jt_v
 from sim_core.physics.plugins import EffectPlugin
-from sim_core.scene.fields import check_keys, number
+from sim_core.scene.fields import Field, Table
 
-__all__ = ["WindLoad", "PLUGIN"]
+__all__ = ["WindLoad", "PLUGIN", "WIND"]
 
 
 class WindLoad(Effect):
@@ -81,26 +81,31 @@ class WindLoad(Effect):
         F += _jt_v(kin.J_r, ctx.wl[:, None] * f)
 
 
+WIND = Table("wind", (
+    # the storm limit of crane operation is ~20 m/s; 70 m/s is a category-5 hurricane
+    Field("speed", "number", "m/s", 10.0, lo=0.0, hi=70.0, note="at the reference height"),
+    Field("direction_deg", "number", "deg", 90.0, lo=-360.0, hi=360.0,
+          note="the azimuth the wind blows towards: 0 = +X, 90 = +Y across the luffing plane"),
+    Field("reference_height", "number", "m", 10.0, lo=1.0, hi=500.0,
+          note="height of the reference speed above the crane's base frame"),
+    Field("exponent", "number", "", 0.0, lo=0.0, hi=1.0,
+          note="power-law height profile: 0 = uniform, 0.14 = open terrain"),
+    Field("air_density", "number", "kg/m^3", 1.225, lo=0.1, hi=2.0),
+    Field("drag_coefficient", "number", "", 1.2, lo=0.01, hi=3.0,
+          note="EN 13000: 1.2 for box-section booms"),
+), note="with effects.wind: the drag of the wind on the exposed booms (sim_core.physics.wind)")
+
+
 def validate(t: dict, scene: dict) -> dict:
-    """The [wind] table: speed m/s (>= 0, at the reference height), direction_deg deg (the
-    azimuth the wind blows towards: 0 = +X, 90 = +Y across the luffing plane), reference_height
-    m (> 0), exponent (0..1: the power-law profile, 0 = uniform), air_density kg/m^3 (> 0),
-    drag_coefficient (> 0)."""
-    check_keys(t, {"speed", "direction_deg", "reference_height", "exponent", "air_density",
-                   "drag_coefficient"}, "wind")
+    """The [wind] table, read through its declaration :data:`WIND`."""
+    WIND.check_keys(t, "wind")
     for i, b in enumerate(scene.get("boom") or []):
         if b["section"]["shape"] == "properties":
             raise SceneError(f"effects.wind = true with boom[{i}].section.shape = 'properties': "
                              "the wind's projected width needs the section's contour (allowed: "
                              "shape 'u', 'box' or 'polygon', or wind = false)")
-    return {"speed": number(t, "speed", "wind", 10.0, lo=0.0),
-            "direction_deg": number(t, "direction_deg", "wind", 90.0, lo=-360.0, hi=360.0),
-            "reference_height": number(t, "reference_height", "wind", 10.0, lo=0.0,
-                                       lo_open=True),
-            "exponent": number(t, "exponent", "wind", 0.0, lo=0.0, hi=1.0),
-            "air_density": number(t, "air_density", "wind", 1.225, lo=0.0, lo_open=True),
-            "drag_coefficient": number(t, "drag_coefficient", "wind", 1.2, lo=0.0,
-                                       lo_open=True)}
+    return {k: WIND.read(t, k, "wind") for k in ("speed", "direction_deg", "reference_height",
+                                                 "exponent", "air_density", "drag_coefficient")}
 
 
 def build(table: dict, system) -> WindLoad:
@@ -124,4 +129,4 @@ def power(effect: WindLoad, model, t: float, Q, Qd) -> float:
 
 
 PLUGIN = EffectPlugin(name="wind", validate=validate, build=build, power=power,
-                      description="drag of the wind on the exposed booms")
+                      description="drag of the wind on the exposed booms", fields=WIND)

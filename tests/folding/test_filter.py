@@ -1,4 +1,4 @@
-"""Stress filter (second seed Eq. 53; docs/model.md#input-filter): increasing h removes the
+"""Stress filter (SIMULTECH 2020 Eq. 53; docs/model.md#input-filter): increasing h removes the
 high-frequency content of the boom-2 tip velocity while the low-frequency response changes
 little.
 

@@ -91,7 +91,7 @@ def test_describe_applies_overrides_parsed_as_toml():
 # -- scene errors: status 2, one line, no traceback -----------------------------------------
 
 @pytest.mark.parametrize("args, parts", [
-    (["describe", SCENE, "--set", "solver.t_end=-1"], ["solver.t_end", "-1", "(0, inf)"]),
+    (["describe", SCENE, "--set", "solver.t_end=-1"], ["solver.t_end", "-1", "[1e-06, 3600] s"]),
     (["run", SCENE, "--set", "boundary.0.speed=-2", "--quiet"],
      ["boundary[0].speed", "-2", "allowed (-1, 0.5)"]),
 ])
@@ -264,7 +264,8 @@ def test_run_without_matplotlib_keeps_results_and_skips_figures(monkeypatch, cap
     assert cli.main(["run", SCENE, "--set", "solver.t_end=0.05", "--out", str(out), "--quiet"]) == 0
     cap = capsys.readouterr()
     assert "matplotlib is not installed, figures skipped" in cap.err
-    assert sorted(p.name for p in out.iterdir()) == ["result.npz", "summary.json"]
+    # the report needs plotly, not matplotlib
+    assert sorted(p.name for p in out.iterdir()) == ["report.html", "result.npz", "summary.json"]
     assert json.loads((out / "summary.json").read_text())["n_rhs"] == 20
     assert cli.main(["plot", str(out / "result.npz")]) == 2
     assert "matplotlib is not installed" in capsys.readouterr().err

@@ -6,14 +6,17 @@ Validation only (no model is built), so these tests are fast.
 
 from __future__ import annotations
 
+import copy
 import math
+import re
+from pathlib import Path
 
 import pytest
 
 from sim_core import load_scene
 from sim_core.errors import SceneError
 from sim_core.scene.io import apply_overrides, parse_value, shipped_scenes
-from sim_core.systems.beam.schema import validate
+from sim_core.systems.beam.schema import BEAMS, GRAVITY, POINT_LOADS, SECTION, SOLVER, validate
 
 SCENE = "beam_through_sleeve"
 
@@ -53,44 +56,47 @@ def test_overrides_do_not_modify_the_raw_scene():
     assert raw == {"solver": {"t_end": 1.0}} and out == {"solver": {"t_end": 2.0}}
 
 
-# -- non-positive material and geometry values ----------------------------------------------
+# -- material and geometry values outside their physical ranges ------------------------------
 
 @pytest.mark.parametrize("key", ["E", "G", "rho", "A", "I_t", "I_b", "J", "I_p"])
-@pytest.mark.parametrize("value", [0.0, -1.0])
-def test_non_positive_section_value(key, value):
+@pytest.mark.parametrize("value", [0.0, -1.0, 1e30])
+def test_section_value_outside_its_range(key, value):
+    """Non-positive and absurdly large section constants are refused with the declared range
+    and its unit (E in [1e8, 1e15] Pa, A in [1e-8, 10] m^2, ...)."""
     msg = err({f"beams.0.section.{key}": value})
-    assert_names(msg, f"beams[0].section.{key}", f"= {value!r}", "(0, inf)")
+    assert_names(msg, f"beams[0].section.{key}", f"= {value!r}", SECTION[key].range_text())
 
 
-@pytest.mark.parametrize("value", [0.0, -12.0])
-def test_non_positive_length(value):
-    assert_names(err({"beams.0.length": value}), "beams[0].length", f"= {value!r}", "(0, inf)")
+@pytest.mark.parametrize("value", [0.0, -12.0, 1e4])
+def test_length_outside_its_range(value):
+    assert_names(err({"beams.0.length": value}), "beams[0].length", f"= {value!r}",
+                 "[0.001, 1000] m")
 
 
 def test_missing_required_value_names_the_range():
-    msg = err({"beams.0.section": {"E": 1.0, "G": 1.0, "rho": 1.0, "A": 1.0, "I_t": 1.0,
-                                   "I_b": 1.0}})
-    assert_names(msg, "beams[0].section.J", "missing", "(0, inf)")
+    sec = load_scene(SCENE)["beams"][0]["section"]
+    msg = err({"beams.0.section": {k: sec[k] for k in ("E", "G", "rho", "A", "I_t", "I_b")}})
+    assert_names(msg, "beams[0].section.J", "missing", SECTION["J"].range_text())
 
 
 # -- NaN and inf anywhere -------------------------------------------------------------------
 
 NUMBER_FIELDS = [
-    ("solver.t_end", "solver.t_end", "(0, inf)"),
-    ("solver.rtol", "solver.rtol", "(0, 1)"),
-    ("solver.atol", "solver.atol", "(0, inf)"),
-    ("solver.max_step", "solver.max_step", "(0, inf)"),
-    ("solver.n_output", "solver.n_output", "[2, inf)"),
-    ("filtering.h", "filtering.h", "(0, inf)"),
-    ("beams.0.length", "beams[0].length", "(0, inf)"),
+    ("solver.t_end", "solver.t_end", "[1e-06, 3600] s"),
+    ("solver.rtol", "solver.rtol", "[1e-12, 0.1]"),
+    ("solver.atol", "solver.atol", "[1e-14, 0.01] m"),
+    ("solver.max_step", "solver.max_step", "[1e-07, 8] s"),       # at most solver.t_end
+    ("solver.n_output", "solver.n_output", "[2, 200001]"),
+    ("filtering.h", "filtering.h", "[0.0001, 1] s"),
+    ("beams.0.length", "beams[0].length", "[0.001, 1000] m"),
     ("beams.0.n_nodes", "beams[0].n_nodes", "[3, 65]"),
     ("beams.0.n_gauss", "beams[0].n_gauss", "[1, 10]"),
-    ("beams.0.section.E", "beams[0].section.E", "(0, inf)"),
-    ("beams.0.section.J", "beams[0].section.J", "(0, inf)"),
-    ("boundary.0.speed", "boundary[0].speed", "(-inf, inf)"),
-    ("point_loads.0.s", "point_loads[0].s", "[0, 12]"),
-    ("point_loads.0.speed", "point_loads[0].speed", "(-inf, inf)"),
-    ("point_loads.0.start", "point_loads[0].start", "[0, inf)"),
+    ("beams.0.section.E", "beams[0].section.E", "[1e+08, 1e+15] Pa"),
+    ("beams.0.section.J", "beams[0].section.J", "[1e-16, 100] m^4"),
+    ("boundary.0.speed", "boundary[0].speed", "[-10, 10] m/s"),
+    ("point_loads.0.s", "point_loads[0].s", "[0, 12] m"),          # on the 12 m beam
+    ("point_loads.0.speed", "point_loads[0].speed", "[-10, 10] m/s"),
+    ("point_loads.0.start", "point_loads[0].start", "[0, 3600] s"),
 ]
 
 
@@ -102,23 +108,35 @@ def test_non_finite_number(key, field, rng, text):
 
 
 VECTOR_FIELDS = [
-    ("gravity.g", "gravity.g"),
-    ("beams.0.origin", "beams[0].origin"),
-    ("beams.0.direction", "beams[0].direction"),
-    ("boundary.0.position", "boundary[0].position"),
-    ("boundary.0.direction", "boundary[0].direction"),
-    ("point_loads.0.force", "point_loads[0].force"),
+    ("gravity.g", "gravity.g", GRAVITY["g"]),
+    ("beams.0.origin", "beams[0].origin", BEAMS["origin"]),
+    ("beams.0.direction", "beams[0].direction", BEAMS["direction"]),
+    ("boundary.0.position", "boundary[0].position", None),
+    ("boundary.0.direction", "boundary[0].direction", None),
+    ("point_loads.0.force", "point_loads[0].force", POINT_LOADS["force"]),
 ]
 
 
+def _component_range(f) -> str:
+    return f"[{f.lo:g}, {f.hi:g}]" + (f" {f.unit}" if f.unit else "")
+
+
 @pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf])
-@pytest.mark.parametrize("key, field", VECTOR_FIELDS)
+@pytest.mark.parametrize("key, field, decl", VECTOR_FIELDS)
 @pytest.mark.parametrize("j", [0, 2])
-def test_non_finite_vector_component(key, field, j, bad):
+def test_non_finite_vector_component(key, field, decl, j, bad):
     vec = [1.0, 0.0, 0.0]
     vec[j] = bad
     msg = err({key: vec})
-    assert_names(msg, f"{field}[{j}]", f"= {bad!r}", "finite", "(-inf, inf)")
+    assert_names(msg, f"{field}[{j}]", f"= {bad!r}", "finite")
+    if decl is not None:
+        assert_names(msg, _component_range(decl))
+
+
+@pytest.mark.parametrize("key, field, decl", [v for v in VECTOR_FIELDS if v[2] is not None])
+def test_vector_component_outside_its_range(key, field, decl):
+    msg = err({key: [0.0, 1.0, decl.hi * 10 + 1.0]})
+    assert_names(msg, f"{field}[2]", "out of range", _component_range(decl))
 
 
 def test_non_finite_vector_component_through_an_indexed_override():
@@ -156,21 +174,27 @@ def test_breakpoints_not_increasing(bps):
     assert_names(msg, "beams[0].breakpoints", repr(bps), "increase strictly", "[0, 12]")
 
 
-@pytest.mark.parametrize("bps", [[-1.0, 12.0], [8.0, 12.5], [-0.5, 13.0]])
-def test_breakpoints_outside_the_beam(bps):
+@pytest.mark.parametrize("bps, j", [([-1.0, 12.0], 0), ([8.0, 12.5], 1), ([-0.5, 13.0], 0)])
+def test_breakpoints_outside_the_beam(bps, j):
     msg = err({"beams.0.breakpoints": bps})
-    assert_names(msg, "beams[0].breakpoints", repr(bps), "[0, 12]")
+    assert_names(msg, f"beams[0].breakpoints[{j}] = {bps[j]!r}", "out of range", "[0, 12] m")
 
 
-@pytest.mark.parametrize("bps", [[8.0], [], 8.0, ["a", 12.0], [True, 12.0]])
-def test_breakpoints_malformed(bps):
+@pytest.mark.parametrize("bps", [[8.0], [], 8.0, list(range(40))])
+def test_breakpoints_not_a_list_of_2_to_33(bps):
     msg = err({"beams.0.breakpoints": bps})
-    assert_names(msg, "beams[0].breakpoints", repr(bps), ">= 2 finite numbers", "[0, 12]")
+    assert_names(msg, "beams[0].breakpoints", "must be a list of 2 to 33 numbers")
+
+
+@pytest.mark.parametrize("bps", [["a", 12.0], [True, 12.0]])
+def test_breakpoints_that_are_not_numbers(bps):
+    msg = err({"beams.0.breakpoints": bps})
+    assert_names(msg, "beams[0].breakpoints[0]", repr(bps[0]), "number", "[0, 12] m")
 
 
 def test_breakpoints_range_follows_the_length():
     msg = err({"beams.0.length": 10.0})            # shipped breakpoints end at 12
-    assert_names(msg, "beams[0].breakpoints", "[8.0, 12.0]", "[0, 10]")
+    assert_names(msg, "beams[0].breakpoints[1] = 12.0", "out of range", "[0, 10] m")
 
 
 # -- integers -------------------------------------------------------------------------------
@@ -204,23 +228,31 @@ def test_n_gauss_limits_accepted(value):
 
 # -- solver ---------------------------------------------------------------------------------
 
-@pytest.mark.parametrize("value", [0.0, 1.0, 1.5, -1e-3])
-def test_rtol_outside_open_unit_interval(value):
-    assert_names(err({"solver.rtol": value}), "solver.rtol", f"= {value!r}", "(0, 1)")
+@pytest.mark.parametrize("value", [0.0, 1e-15, 0.5, 1.0, -1e-3])
+def test_rtol_outside_its_range(value):
+    assert_names(err({"solver.rtol": value}), "solver.rtol", f"= {value!r}",
+                 SOLVER["rtol"].range_text())
 
 
-@pytest.mark.parametrize("value", [0.0, -1.0])
-def test_t_end_not_positive(value):
-    assert_names(err({"solver.t_end": value}), "solver.t_end", f"= {value!r}", "(0, inf)")
+@pytest.mark.parametrize("value", [0.0, -1.0, 1e5])
+def test_t_end_outside_its_range(value):
+    assert_names(err({"solver.t_end": value}), "solver.t_end", f"= {value!r}",
+                 "[1e-06, 3600] s")
 
 
 def test_t_end_missing():
     raw_solver = {"rtol": 1e-6}
-    assert_names(err({"solver": raw_solver}), "solver.t_end", "missing", "(0, inf)")
+    assert_names(err({"solver": raw_solver}), "solver.t_end", "missing", "[1e-06, 3600] s")
 
 
 def test_t_end_not_a_number():
-    assert_names(err({"solver.t_end": "soon"}), "solver.t_end", "'soon'", "number", "(0, inf)")
+    assert_names(err({"solver.t_end": "soon"}), "solver.t_end", "'soon'", "number",
+                 "[1e-06, 3600] s")
+
+
+def test_max_step_at_most_t_end():
+    assert_names(err({"solver.max_step": 9.0}), "solver.max_step", "= 9.0", "[1e-07, 8] s")
+    assert load_scene(SCENE, {"solver.max_step": 8.0})["solver"]["max_step"] == 8.0
 
 
 def test_unknown_method_suggests():
@@ -234,11 +266,13 @@ def test_one_solver_table_for_every_scene_kind(scene):
     scene kinds: the same methods are accepted, the same errors name the field and range."""
     for method in ("RK45", "BDF", "auto"):
         assert load_scene(scene, overrides={"solver.method": method})["solver"]["method"] == method
+    t_end = load_scene(scene)["solver"]["t_end"]
     assert_names(err({"solver.method": "Radau"}, scene), "solver.method", "'Radau'",
                  "RK45", "BDF", "auto")
-    assert_names(err({"solver.max_step": 0}, scene), "solver.max_step", "(0, inf)")
-    assert_names(err({"solver.max_wall_s": -1}, scene), "solver.max_wall_s", "(0, inf)")
-    assert_names(err({"solver.rtol": 1.0}, scene), "solver.rtol", "(0, 1)")
+    assert_names(err({"solver.max_step": 0}, scene), "solver.max_step",
+                 f"[1e-07, {t_end:g}] s")
+    assert_names(err({"solver.max_wall_s": -1}, scene), "solver.max_wall_s", "(0, 86400] s")
+    assert_names(err({"solver.rtol": 1.0}, scene), "solver.rtol", "[1e-12, 0.1]")
 
 
 @pytest.mark.parametrize("key, field", [("effects.gravity", "effects.gravity"),
@@ -318,6 +352,22 @@ def test_unknown_beam_name_suggests(key, field):
     assert_names(msg, field, "'rood'", "no such beam (rod)", "did you mean 'rod'?")
 
 
+@pytest.mark.parametrize("key, value, shown", [
+    ("boundary.0.position", [1.0, 0.0, 0.0], "[0, 0, 0] m"),
+    ("boundary.0.direction", [0.0, 1.0, 0.0], "[1, 0, 0]"),
+    ("boundary.0.end", "right", "[4, 0, 0] m"),
+])
+def test_boundary_held_where_the_straight_beam_has_its_end(key, value, shown):
+    """The model starts straight and at rest: a boundary's position and direction are the
+    straight beam's end and axis (the rod's left end s = 8 m sits at the origin, its right end
+    s = 12 m at x = 4 m), else the first state would break the condition."""
+    msg = err({key: value})
+    field = key.replace("boundary.0", "boundary[0]")
+    if key.endswith("end"):
+        field = "boundary[0].position"
+    assert_names(msg, field, "straight beam 'rod'", shown, "allowed")
+
+
 def test_duplicate_beam_names():
     sc = load_scene(SCENE)
     raw_beam = {"name": "rod", "length": 12.0, "breakpoints": [8.0, 12.0],
@@ -390,7 +440,8 @@ def test_left_sleeve_with_inner_breakpoint():
 
 
 RIGHT = {"beams.0.breakpoints": [0.0, 8.0], "beams.0.origin": [0.0, 0.0, 0.0],
-         "boundary.0.end": "right", "point_loads.0.s": 4.0}
+         "boundary.0.end": "right", "boundary.0.position": [8.0, 0.0, 0.0],
+         "point_loads.0.s": 4.0}
 
 
 @pytest.mark.parametrize("speed", [0.5, 1.0, -1.0, -2.0])
@@ -448,7 +499,7 @@ def test_moving_point_load_on_the_beam_is_accepted(speed):
 
 
 def test_point_load_start_negative():
-    assert_names(err({"point_loads.0.start": -1.0}), "point_loads[0].start", "[0, inf)")
+    assert_names(err({"point_loads.0.start": -1.0}), "point_loads[0].start", "[0, 3600] s")
 
 
 # -- tables of the wrong type ---------------------------------------------------------------
@@ -531,7 +582,7 @@ def test_override_value_of_the_wrong_type_names_the_field():
 from hypothesis import HealthCheck, given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
-FUZZ_KEYS = [k for k, _, _ in NUMBER_FIELDS] + [k for k, _ in VECTOR_FIELDS] + [
+FUZZ_KEYS = [k for k, _, _ in NUMBER_FIELDS] + [k for k, _, _ in VECTOR_FIELDS] + [
     "name", "description", "solver", "solver.method", "effects.torsion", "effects", "filtering",
     "gravity", "beams", "beams.0", "beams.0.name", "beams.0.breakpoints", "beams.0.section",
     "beams.0.section.rotary_bending", "boundary", "boundary.0", "boundary.0.beam",
@@ -572,3 +623,198 @@ def test_fuzzed_overrides_give_a_scene_or_a_scene_error(overrides):
 @pytest.mark.parametrize("key", ["name", "description"])
 def test_name_and_description_are_strings(key):
     assert_names(err({key: 5}), f"scene.{key}", "= 5", "string")
+
+
+# -- the declared fields: complete, checked by the validators, rendered cleanly ---------------
+
+from sim_core.scene.fields import COMPUTED, OPTIONAL, REQUIRED  # noqa: E402
+from sim_core.systems.beam.schema import SCHEMA as BEAM_SCHEMA  # noqa: E402
+from sim_core.systems.folding.schema import SCHEMA as FOLDING_SCHEMA  # noqa: E402
+from sim_core.systems.telescopic.schema import SCHEMA as TELESCOPIC_SCHEMA  # noqa: E402
+
+SCHEMAS = {"beam": BEAM_SCHEMA, "telescopic": TELESCOPIC_SCHEMA, "folding": FOLDING_SCHEMA}
+UNITS = {"", "s", "m", "m/s", "m/s^2", "m/s^3", "deg", "deg/s", "deg/s^2", "deg/s^3", "Pa",
+         "kg", "kg/m", "kg/m^3", "m^2", "m^4", "N", "N/m", "N s/m", "N m/rad"}
+DECLARED = [(kind, table, f) for kind, s in SCHEMAS.items() for table in s.tables
+            for f in table.fields]
+
+
+def _ids(item):
+    kind, table, f = item
+    return f"{kind}:{table.path}.{f.key}" if table.path else f"{kind}:{f.key}"
+
+
+@pytest.mark.parametrize("kind, table, f", DECLARED, ids=[_ids(d) for d in DECLARED])
+def test_every_declared_key_has_a_type_unit_range_and_default(kind, table, f):
+    """Every key: an SI unit from the list (or none), a bounded range for every number (a
+    literal default inside it), a default that is a value, required, optional or computed
+    (said in words)."""
+    assert f.unit in UNITS, f.unit
+    assert f.range_text() and "inf" not in f.range_text()
+    if f.type in ("number", "integer", "vector", "numbers"):
+        assert math.isfinite(f.lo) and math.isfinite(f.hi) and f.lo < f.hi
+    if f.type == "rows":
+        assert all(math.isfinite(lo) and math.isfinite(hi) and lo < hi for lo, hi, _ in f.columns)
+    if f.default is COMPUTED:
+        assert f.default_text
+    elif f.default not in (REQUIRED, OPTIONAL):
+        d = f.default
+        if f.type in ("number", "integer"):
+            assert f.bounds()[0] <= d <= f.bounds()[1]
+        elif f.type in ("vector", "numbers"):
+            assert all(f.lo <= x <= f.hi for x in d)
+        elif f.type == "choice":
+            assert d in f.choices
+        elif f.type == "boolean":
+            assert isinstance(d, bool)
+
+
+# where each declared table is read: (scene, overrides)
+U_SECTION = {"shape": "u", "top_arc_centre_y": 0.2, "top_arc_centre_z": 0.1,
+             "top_arc_radius": 0.1, "wall": 0.01}
+BOX_SECTION = {"shape": "box", "width": 0.8, "height": 0.8, "wall": 0.01, "corner_radius": 0.05}
+PROPS_SECTION = {"shape": "properties", "A": 0.02, "I_t": 2e-3, "I_b": 2e-3, "J": 3e-3,
+                 "mass_per_length": 170.0}
+CONTEXTS = {
+    "beam": [("beam_through_sleeve", {}),
+             ("beam_through_sleeve", {"boundary.0.profile": "cubic", "boundary.0.speed": -0.1}),
+             ("cantilever_release", {}),
+             ("beam_through_sleeve", {"solver.method": "generalized_alpha"})],
+    "telescopic": [
+        ("telescopic_extraction", {}),
+        ("telescopic_extraction", {"drive.profile": "trapezoid", "drive.travel": 3.0,
+                                   "drive.a_max": 0.5}),
+        ("telescopic_extraction", {"effects.wind": True}),
+        ("crane_lift_and_slew", {}),
+        ("crane_lift_and_slew", {"hoist_drive": {"profile": "trapezoid", "travel": -1.0,
+                                                 "v_max": 0.5, "a_max": 0.5}}),
+        ("crane_lift_and_slew", {"luffing_drive": {"profile": "trapezoid", "travel": 10.0,
+                                                   "v_max": 2.0, "a_max": 1.0}}),
+        ("crane_lift_and_slew", {"slew_drive": {"profile": "cubic", "travel": 10.0,
+                                                "t_hold_end": 20.0}}),
+        ("crane_lift_and_slew", {"hoist_drive": {"profile": "cubic", "travel": -1.0,
+                                                 "t_hold_end": 20.0}}),
+        ("crane_hexagonal_4", {}),
+        ("crane_hexagonal_4", {"boom.0": {"length": 12.0, "section": {
+            "shape": "polygon", "n_sides": 6, "width_across_flats": 0.8, "wall": 0.008}}}),
+        ("crane_hexagonal_4", {"boom.0.section": U_SECTION}),
+        ("crane_hexagonal_4", {"boom.0.section": BOX_SECTION}),
+        ("crane_hexagonal_4", {"boom.0.section": {"shape": "polygon", "circumradius": 0.45,
+                                                  "n_sides": 6, "wall": 0.008}}),
+        ("crane_hexagonal_4", {"boom.0.section": {
+            "shape": "polygon", "wall": 0.008,
+            "contour": [[0.45, -0.45], [0.45, 0.45], [-0.45, 0.45], [-0.45, -0.45]]}}),
+        ("crane_hexagonal_4", {"boom.0.section": PROPS_SECTION,
+                               "effects.contact_distribution": False}),
+        ("telescopic_extraction_rl", {}),
+    ],
+    "folding": [("folding_boom", {})],
+}
+
+
+def _display(path: str, key: str) -> str:
+    base = path.replace("[]", "[0]")
+    return f"{base}.{key}" if base else key
+
+
+def _override_key(path: str, key: str) -> str:
+    base = path.replace("[]", ".0")
+    return f"{base}.{key}" if base else key
+
+
+def _too_large(f):
+    if f.type == "vector":
+        return [f.hi * 10 + 1.0] * f.n
+    if f.type == "numbers":
+        return [f.hi * 10 + 1.0 + j for j in range(f.items[0])]
+    return int(f.hi * 10 + 1) if f.type == "integer" else f.hi * 10 + 1.0
+
+
+NUMERIC = [d for d in DECLARED if d[2].type in ("number", "integer", "vector", "numbers")]
+
+
+@pytest.mark.parametrize("kind, table, f", NUMERIC, ids=[_ids(d) for d in NUMERIC])
+def test_every_declared_range_is_what_the_validator_checks(kind, table, f):
+    """A value ten times the declared upper bound is refused, in a scene that reads the key,
+    with an error naming the field and "out of range" (the declared range, or one narrowed by
+    other keys); the declaration and the check are one."""
+    key, shown = _override_key(table.path, f.key), _display(table.path, f.key)
+    messages = []
+    for scene, over in CONTEXTS[kind]:
+        try:
+            load_scene(scene, {**copy.deepcopy(over), key: _too_large(f)})
+        except SceneError as exc:
+            msg = str(exc)
+            messages.append(msg)
+            if msg.startswith(shown) and "out of range" in msg:
+                if f.allowed == "" and f.type in ("number", "integer"):
+                    assert f.range_text() in msg, msg
+                return
+    pytest.fail(f"{shown}: no context refused {_too_large(f)!r} naming the field: {messages}")
+
+
+def _unknown_key_list(scene: str, over: dict, key: str) -> set[str]:
+    msg = err({**copy.deepcopy(over), key: 1.0}, scene)
+    assert "unknown key (allowed: " in msg, msg
+    return set(msg.split("(allowed: ")[1].split(")")[0].split(", "))
+
+
+@pytest.mark.parametrize("kind", SCHEMAS)
+def test_the_validators_accept_exactly_the_declared_keys(kind):
+    """The keys an unknown-key error lists for every table are the declared ones (the
+    section's per shape, the profiles' all together)."""
+    schema = SCHEMAS[kind]
+    from sim_core.physics.plugins import effect_plugins
+    plugins = set(effect_plugins()) if kind == "telescopic" else set()
+    for table in schema.tables:
+        want = table.all_keys() | (plugins if table.path in ("", "effects") else set())
+        tag = None
+        if table.path == "boom[].section":
+            tag = "polygon"
+            want = table.keys("polygon")
+        key = _override_key(table.path, "zz_unknown")
+        for scene, over in CONTEXTS[kind]:
+            try:
+                got = _unknown_key_list(scene, over, key)
+            except (AssertionError, pytest.fail.Exception):
+                continue
+            assert got == want, (table.path, tag, got ^ want)
+            break
+        else:
+            pytest.fail(f"{table.path}: no context reads the table")
+
+
+def _reference_page() -> str:
+    import importlib.util
+    path = Path(__file__).resolve().parents[2] / "docs" / "hooks" / "scene_reference.py"
+    spec = importlib.util.spec_from_file_location("scene_reference_hook", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod.scene_reference()
+
+
+def test_the_scene_reference_is_rendered_from_the_declarations_without_debris():
+    """The generated page lists every declared key of every kind in a six-column row with its
+    type, no source code (``out.``, ``sc[``, ``len(``, conditional expressions, constant
+    names), no empty cells where a type or range belongs, the generalized-alpha keys only for
+    the beam scenes (the only kind that takes the method)."""
+    page = _reference_page()
+    sections = page.split("\n## ")
+    assert len(sections) == 3
+    for debris in (r"\bout\.", r"\bsc\[", r"\bsc\.", r"len\(", r" if .* else ", r"\bMAX_",
+                   r"self\.", r"`three`", r"\| methods \|", "…", r"h_lo", r"\blo_open\b"):
+        assert not re.search(debris, page), debris
+    for section, (kind, schema) in zip(sections, SCHEMAS.items()):
+        rows = [ln for ln in section.splitlines() if ln.startswith("| `")]
+        keys = {ln.split("`")[1] for ln in rows}
+        for table in schema.tables:
+            for f in table.fields:
+                assert _override_key(table.path, f.key) in keys, (kind, table.path, f.key)
+        for ln in rows:
+            cells = re.split(r"(?<!\\)\|", ln)[1:-1]
+            if len(cells) == 6:
+                key, typ, unit, default, allowed, note = (c.strip() for c in cells)
+                assert typ != "–" and default and allowed and allowed != "–", ln
+        alpha = {"solver.h", "solver.h_max", "solver.rho_inf", "solver.newton_atol"}
+        assert (alpha <= keys) == (kind == "beam"), kind
+        assert "### Rules across keys" in section and "### Shipped scenes of this kind" in section

@@ -1,5 +1,5 @@
-"""Shared machinery of the numerical-stability suite (hard cases of the issue "Hard cases stay
-numerically stable").
+"""Shared machinery of the numerical-stability suite (hard cases that must stay numerically
+stable).
 
 * Static equilibria cost ~25 s each at n_nodes = 3 (finite-difference tangent in the constrained
   Newton solve), so they are cached per session and keyed by the parameters that change the

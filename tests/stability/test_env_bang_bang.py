@@ -62,7 +62,9 @@ def test_env_reports_divergence_of_the_solver_instead_of_nan():
     env.reset(seed=0)
     for _ in range(5):
         env.step(np.ones(1, np.float32))
-    env.unwrapped.rom.qd = env.unwrapped.rom.qd * np.nan
+    sim = env.unwrapped.plant.sim                           # the modal plant's Simulation
+    state = sim.save_state()
+    sim.restore_state({**state, "qd": np.asarray(state["qd"]) * np.nan})
     obs, r, term, trunc, info = env.step(-np.ones(1, np.float32))
     assert trunc and not term and info["diverged"] and info["reason"]
     assert np.all(np.isfinite(obs)) and np.isfinite(r)

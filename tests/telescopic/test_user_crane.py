@@ -52,7 +52,7 @@ def test_two_section_tip_deflection_matches_stepped_beam():
     deflection (4 mm for P = 9.81 kN over 13 m) keeps the geometrically exact model's
     nonlinearity at (delta/L)^2 ~ 1e-7.  The splines converge to the hand value from below
     (0.52 % with 4, 0.34 % with 8 sub-elements per element: boom 2's left end loads boom 1
-    inside an element).  Tolerance 1 % (the issue's)."""
+    inside an element).  Tolerance 1 % (the acceptance tolerance of the own-crane validation)."""
     E, G = 2.1e11, 8.1e10
     L1, L2, a, L_h = 10.0, 9.0, 4.0, 3.0
     I1, I2 = 4.0e-3, 2.5e-3
@@ -109,7 +109,7 @@ def test_luffing_cylinder_force_matches_virtual_work(geometry, angle):
     virtual-work statics of the rigid crane (closed_form.rigid_luffing_force).  The booms are
     stiff (E = 2.1e14 Pa, 1000 x steel), so the deflection moves the weights' arms by
     ~1e-5 of the reach; ropes and the telescopic cylinder are internal forces and drop out.
-    Tolerance 0.5 % (the issue's)."""
+    Tolerance 0.5 % (the acceptance tolerance of the own-crane validation)."""
     raw = {"kind": "telescopic", "solver": {"t_end": 1.0},
            "booms": {"luffing_angle_deg": angle, "E": 2.1e14, "n_nodes": 3, "count": 3},
            "luffing": GEOMETRIES[geometry],

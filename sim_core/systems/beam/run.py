@@ -116,7 +116,7 @@ def beam_energy_check(model, scene: dict, res: Result) -> dict:
     return {"energy_balance": verdict(value, ENERGY_SUSPECT + q, ENERGY_FAIL + q, what)}
 
 
-def run(scene: dict, progress=None) -> Result:
+def run(scene: dict, progress=None, checkpoint=None) -> Result:
     """Integrate a validated beam scene (:func:`sim_core.systems.beam.schema.validate`) from
     its initial state (or its static equilibrium) and return a Result.
 
@@ -130,6 +130,9 @@ def run(scene: dict, progress=None) -> Result:
     violation (:func:`result_checks`).  The verdicts are in ``result.stats`` (``checks``,
     ``suspect``, ``failed_checks``; ``Result.suspect``, ``Result.suspect_note()``); a gross
     failure raises :class:`sim_core.errors.SuspectResult` with the result attached.
+
+    ``checkpoint``: a :class:`sim_core.checkpoint.Checkpointer` the integration writes to and
+    resumes from (None: no checkpoints).
     """
     model, Q0, Qd0 = build_model(scene)
     sol = scene["solver"]
@@ -137,7 +140,7 @@ def run(scene: dict, progress=None) -> Result:
     if scene["initial"]["static_equilibrium"]:
         z0 = static_equilibrium(model, z0)
     y0 = np.concatenate([z0, zd0])
-    return run_with_partial(lambda: integrate(model, y0, sol["t_end"], sol, progress),
+    return run_with_partial(lambda: integrate(model, y0, sol["t_end"], sol, progress, checkpoint),
                             lambda ts, ys, stats, err: _beam_result(model, scene, ts, ys, stats, err),
                             lambda res: beam_energy_check(model, scene, res))
 

@@ -1,4 +1,4 @@
-"""Folding long-boom manipulator (second seed: SIMULTECH 2020, "folding long-boom manipulator";
+"""Folding long-boom manipulator (SIMULTECH 2020, "folding long-boom manipulator";
 inputs in docs/model.md#input-folding): two flexible booms, turntable, two hydraulic cylinders
 (barrel + rod), two links; luffing of boom 1, slewing by 90 deg, unfolding of boom 2.
 
@@ -21,7 +21,7 @@ S(phi) about X; the plane goes from XY to XZ for phi = -90 deg).  The booms stay
 and may deflect out of the plane.  Luffing-plane coordinates (u, v) -> global: e_u = -Y
 (towards boom 1's tip at t = 0), e_v = X (up), normal n = Z; gravity -X (PD).
 
-Joints (second seed Section 2.1, Eq. 7; Baumgarte Eq. 8 with xi1 = xi2 = 10 1/s in
+Joints (SIMULTECH 2020 Section 2.1, Eq. 7; Baumgarte Eq. 8 with xi1 = xi2 = 10 1/s in
 :class:`sim_core.model.model.Model`)
   * hinge A (turntable - boom 1 foot) and hinge B (boom 1 tip - boom 2 foot): revolute =
     3 point rows + 2 axis rows (:func:`sim_core.physics.rigid_body.revolute_axis`);
@@ -333,7 +333,7 @@ def build_folding(p: FoldingParams) -> FoldingSystem:
     g_vec = np.array([-p.gravity, 0.0, 0.0])
     effects: list[Effect] = [Inertia(), Elasticity()]
     if p.filter_h > 0:
-        effects.append(StressFilter(p.filter_h))           # second seed Eq. 53
+        effects.append(StressFilter(p.filter_h))           # SIMULTECH 2020 Eq. 53
     if p.gravity > 0:
         effects.append(Gravity(g_vec))
 
@@ -575,13 +575,16 @@ def angular_momentum(fs: FoldingSystem, Q: np.ndarray, Qd: np.ndarray) -> np.nda
 
 def simulate_folding(p: FoldingParams, t_end: float = 45.0, n_output: int = 451,
                      rtol: float = 1e-6, atol: float = 1e-8, progress=None,
-                     solver: dict | None = None, scene: dict | None = None):
+                     solver: dict | None = None, scene: dict | None = None,
+                     checkpoint=None):
     """Run the folding scene from its static equilibrium; Result with tip_position,
     tip_velocity (boom-2 tip, m, m/s), cylinder_forces (N, pushing positive, one column per
     cylinder), cylinder_lengths (m), slew_angle (rad), boom_angles (boom-1 elevation and
     boom-2 relative angle from the rigid-body chain, rad) and constraint_violation (max |Phi|,
     m or rad).  ``solver``: a validated [solver] table (:func:`sim_core.scene.fields.solver_table`);
-    its entries (method, max_step, max_wall_s, ...) take precedence over the keyword arguments."""
+    its entries (method, max_step, max_wall_s, ...) take precedence over the keyword arguments.
+    ``checkpoint``: a :class:`sim_core.checkpoint.Checkpointer` the integration writes to and
+    resumes from."""
     from sim_core.integrate.driver import integrate, run_with_partial
     fs = build_folding(p)
     m = fs.model
@@ -593,7 +596,7 @@ def simulate_folding(p: FoldingParams, t_end: float = 45.0, n_output: int = 451,
         Q, _ = m.full_state(0.0, z0, 0 * z0)
         y0[m.n_dof:] = m.reduced_state(0.0, Q, Qd)[1]
     sol = {"t_end": t_end, "rtol": rtol, "atol": atol, "n_output": n_output, **(solver or {})}
-    return run_with_partial(lambda: integrate(m, y0, sol["t_end"], sol, progress),
+    return run_with_partial(lambda: integrate(m, y0, sol["t_end"], sol, progress, checkpoint),
                             lambda t, ys, st, err: folding_result(fs, t, ys, st, err, scene))
 
 

@@ -1,4 +1,4 @@
-"""The folding long-boom manipulator kind (``kind = "folding"``, the second seed)."""
+"""The folding long-boom manipulator kind (``kind = "folding"``, the SIMULTECH 2020 paper)."""
 
 from __future__ import annotations
 
@@ -19,10 +19,12 @@ def build(scene: dict):
     return build_folding(params_from_scene(scene))
 
 
-def run(scene: dict, progress=None) -> Result:
-    """The manipulator from its static equilibrium through the drive stages."""
+def run(scene: dict, progress=None, checkpoint=None) -> Result:
+    """The manipulator from its static equilibrium through the drive stages; ``checkpoint``
+    (:class:`sim_core.checkpoint.Checkpointer` or None): the integration writes to it and
+    resumes from it."""
     return simulate_folding(params_from_scene(scene), progress=progress, solver=scene["solver"],
-                            scene=scene)
+                            scene=scene, checkpoint=checkpoint)
 
 
 def describe(scene: dict) -> list[str]:

@@ -1,4 +1,4 @@
-"""Figures of the folding-boom scene (second seed Figs. 6-8 kinds): boom-2 tip displacement per
+"""Figures of the folding-boom scene (SIMULTECH 2020 Figs. 6-8 kinds): boom-2 tip displacement per
 axis, tip velocity for several filter windows h, cylinder forces (PNG, written atomically)."""
 
 from __future__ import annotations

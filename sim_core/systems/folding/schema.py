@@ -1,23 +1,8 @@
 """Scene schema of the folding long-boom manipulator (kind = "folding"), SI units.
 
-  kind = "folding", name, description, notes
-  [solver]     t_end s (> 0), rtol (0, 1), atol (> 0), n_output (>= 2), method ("RK45", "BDF",
-               "auto"), max_step s and max_wall_s s (> 0, optional)
-  [booms]      length m (> 1), radius m (> 0), mass_per_length kg/m (> 0), E Pa (> 0),
-               nu (-1, 0.5), n_nodes (3..33, nodes of the one spline element per boom; PD 9 =
-               8 sub-elements), n_gauss (1..10; PD 3)
-  [cylinders]  k N/m (> 0), c N s/m (>= 0), barrel_mass, rod_mass kg (> 0)
-  [drive]      t1 s (> 0), t2 s (>= 0), t3 s (> 0) (Eq. 52), stage_starts s (3 increasing
-               values >= 0: luff, slew, unfold; a stage may not start before the previous one
-               ends, start + t1 + t2 + t3), cyl1_stroke m (> 0), slew_angle_deg ([-180, 180],
-               non-zero; PD -90 = clockwise seen from above), cyl2_stroke m (> 0)
-  [rest]       k N/m (>= 0, 0 = no boom rest), c N s/m (>= 0)
-  [effects]    gravity (bool), filtering (bool)
-  [filtering]  h s (> 0): stress-averaging window (second seed Eq. 53)
-  [gravity]    g m/s^2 (> 0, along -X)
-Geometry rules (closed-form linkage, booms rigid): the cylinder-1 stroke must keep boom 1's
-elevation in [0, 85] deg; the cylinder-2 stroke must keep the links assemblable with boom 2's
-relative angle in (0, 180] deg (errors name drive.cyl1_stroke / drive.cyl2_stroke).
+Every key is declared once in :data:`SCHEMA` (type, unit, default, allowed range, note) and read
+through the declarations (:mod:`sim_core.scene.fields`); the scene reference of the
+documentation is rendered from them.  PD: the SIMULTECH 2020 paper's parameter set.
 """
 
 from __future__ import annotations
@@ -27,80 +12,140 @@ from typing import Any
 import numpy as np
 
 from sim_core.errors import SceneError
-from sim_core.scene.fields import ERROR_CONTROLLED, boolean, check_keys, number, solver_table
+from sim_core.scene.fields import (
+    ERROR_CONTROLLED,
+    T_MAX,
+    Field,
+    Schema,
+    Table,
+    read_text,
+    short_repr,
+    solver_fields,
+    solver_table,
+    table_of,
+    text_fields,
+    time_field,
+)
 from sim_core.systems.folding.build import FoldingParams, cylinder_lengths
 
-_TOP = {"kind", "name", "description", "notes", "solver", "booms", "cylinders", "drive", "rest",
-        "effects", "filtering", "gravity"}
+# -- the declarations ---------------------------------------------------------------------------
+
+TOP = Table("", (Field("kind", "choice", choices=("folding",)), *text_fields("folding")),
+            tables=("solver", "booms", "cylinders", "drive", "rest", "effects", "filtering",
+                    "gravity"))
+SOLVER = solver_fields(t_end=45.0, n_output=451, methods=ERROR_CONTROLLED)
+BOOMS = Table("booms", (
+    Field("length", "number", "m", 12.0, lo=1.0, hi=100.0, lo_open=True,
+          note="each of the two booms"),
+    Field("radius", "number", "m", 0.15, lo=1e-3, hi=2.0,
+          note="outer radius of the booms' circular tube"),
+    Field("mass_per_length", "number", "kg/m", 544.6, lo=0.1, hi=1e5),
+    Field("E", "number", "Pa", 2.11e11, lo=1e8, hi=1e15, note="Young's modulus"),
+    Field("nu", "number", "", 0.3, lo=-1.0, hi=0.5, lo_open=True, hi_open=True,
+          note="Poisson's ratio"),
+    Field("n_nodes", "integer", "", 9, lo=3, hi=33,
+          note="nodes of the one spline element per boom; PD 9 = 8 sub-elements"),
+    Field("n_gauss", "integer", "", 3, lo=1, hi=10, note="Gauss points per sub-element; PD 3"),
+), note="the two flexible booms")
+CYLINDERS = Table("cylinders", (
+    Field("k", "number", "N/m", 5e7, lo=1e3, hi=1e12, note="axial stiffness"),
+    Field("c", "number", "N s/m", 4e5, lo=0.0, hi=1e10, note="axial damping"),
+    Field("barrel_mass", "number", "kg", 10.0, lo=0.01, hi=1e4),
+    Field("rod_mass", "number", "kg", 10.0, lo=0.01, hi=1e4),
+), note="the two hydraulic cylinders")
+DRIVE = Table("drive", (
+    time_field("t1", 3.0, lo=1e-3, note="rise of each stage (Eq. 52)"),
+    time_field("t2", 6.0, note="hold of each stage (Eq. 52)"),
+    time_field("t3", 3.0, lo=1e-3, note="decay of each stage (Eq. 52)"),
+    Field("stage_starts", "numbers", "s", [0.0, 15.0, 30.0], lo=0.0, hi=T_MAX, items=(3, 3),
+          note="start of the luff, slew and unfold stages; a stage starts after the previous "
+               "one ends (start + t1 + t2 + t3)"),
+    Field("cyl1_stroke", "number", "m", 1.328, lo=1e-3, hi=10.0,
+          allowed="[0.001, 10] m, and boom 1 stays below 85 deg",
+          note="stroke of cylinder 1 (luffing boom 1)"),
+    Field("slew_angle_deg", "number", "deg", -90.0, lo=-180.0, hi=180.0,
+          allowed="[-180, 180] deg, not 0", note="slew stage; PD -90 = clockwise seen from above"),
+    Field("cyl2_stroke", "number", "m", 1.242, lo=1e-3, hi=10.0,
+          allowed="[0.001, 10] m, and the links stay assemblable",
+          note="stroke of cylinder 2 (unfolding boom 2)"),
+), note="the three drive stages (Eq. 52)")
+REST = Table("rest", (
+    Field("k", "number", "N/m", 1e7, lo=0.0, hi=1e12, note="0 = no boom rest"),
+    Field("c", "number", "N s/m", 1e4, lo=0.0, hi=1e10),
+), note="the rest boom 2 lies on at the start")
+EFFECTS = Table("effects", (
+    Field("gravity", "boolean", default=True),
+    Field("filtering", "boolean", default=True, note="stress averaging over [filtering] h"),
+))
+FILTERING = Table("filtering", (
+    Field("h", "number", "s", 0.005, lo=1e-4, hi=1.0,
+          note="stress-averaging window (SIMULTECH 2020 Eq. 53)"),
+))
+GRAVITY = Table("gravity", (
+    Field("g", "number", "m/s^2", 9.81, lo=0.0, hi=100.0, lo_open=True, note="along -X"),
+))
+
+SCHEMA = Schema(
+    "folding", 'Folding scenes (`kind = "folding"`)',
+    "sim_core.systems.folding.schema.validate_folding",
+    (TOP, SOLVER, BOOMS, CYLINDERS, DRIVE, REST, EFFECTS, FILTERING, GRAVITY),
+    rules=(
+        "The drive stages do not overlap: each of drive.stage_starts is at least the previous "
+        "one plus t1 + t2 + t3.",
+        "Closed-form linkage (booms rigid): drive.cyl1_stroke keeps boom 1's elevation in "
+        "[0, 85] deg; drive.cyl2_stroke keeps the links assemblable with boom 2's relative "
+        "angle in (0, 180] deg (the errors give the largest strokes).",
+    ))
 
 
 def validate_folding(raw: dict, source: str) -> dict[str, Any]:
-    check_keys(raw, _TOP, "scene")
-    sc: dict[str, Any] = {"kind": "folding", "name": str(raw.get("name", "folding")),
-                          "description": str(raw.get("description", "")), "source": source}
-    sc["solver"] = solver_table(raw.get("solver", {}), t_end=45.0, n_output=451,
+    TOP.check_keys(raw, "scene")
+    TOP.read(raw, "kind", "scene")
+    sc: dict[str, Any] = {"kind": "folding"}
+    read_text(raw, TOP, sc, "folding")
+    sc["source"] = source
+    sc["solver"] = solver_table(table_of(raw, "solver", ""), t_end=45.0, n_output=451,
                                 methods=ERROR_CONTROLLED)
-    b = raw.get("booms", {})
-    check_keys(b, {"length", "radius", "mass_per_length", "E", "nu", "n_nodes", "n_gauss"}, "booms")
-    sc["booms"] = {"length": number(b, "length", "booms", 12.0, lo=1.0, lo_open=True),
-                   "radius": number(b, "radius", "booms", 0.15, lo=0.0, lo_open=True),
-                   "mass_per_length": number(b, "mass_per_length", "booms", 544.6, lo=0.0,
-                                             lo_open=True),
-                   "E": number(b, "E", "booms", 2.11e11, lo=0.0, lo_open=True),
-                   "nu": number(b, "nu", "booms", 0.3, lo=-1.0, hi=0.5, lo_open=True,
-                                hi_open=True),
-                   "n_nodes": number(b, "n_nodes", "booms", 9, lo=3, hi=33, integer=True),
-                   "n_gauss": number(b, "n_gauss", "booms", 3, lo=1, hi=10, integer=True)}
-    c = raw.get("cylinders", {})
-    check_keys(c, {"k", "c", "barrel_mass", "rod_mass"}, "cylinders")
-    sc["cylinders"] = {"k": number(c, "k", "cylinders", 5e7, lo=0.0, lo_open=True),
-                       "c": number(c, "c", "cylinders", 4e5, lo=0.0),
-                       "barrel_mass": number(c, "barrel_mass", "cylinders", 10.0, lo=0.0,
-                                             lo_open=True),
-                       "rod_mass": number(c, "rod_mass", "cylinders", 10.0, lo=0.0, lo_open=True)}
-    d = raw.get("drive", {})
-    check_keys(d, {"t1", "t2", "t3", "stage_starts", "cyl1_stroke", "slew_angle_deg",
-                   "cyl2_stroke"}, "drive")
-    t1 = number(d, "t1", "drive", 3.0, lo=0.0, lo_open=True)
-    t2 = number(d, "t2", "drive", 6.0, lo=0.0)
-    t3 = number(d, "t3", "drive", 3.0, lo=0.0, lo_open=True)
-    starts = d.get("stage_starts", [0.0, 15.0, 30.0])
-    if (not isinstance(starts, list) or len(starts) != 3
-            or not all(isinstance(x, (int, float)) and not isinstance(x, bool)
-                       and np.isfinite(x) for x in starts)):
-        raise SceneError(f"drive.stage_starts = {starts!r}: must be a list of 3 finite numbers "
-                         "(luff, slew, unfold start times, s)")
+    b = table_of(raw, "booms", "")
+    BOOMS.check_keys(b, "booms")
+    sc["booms"] = {k: BOOMS.read(b, k, "booms") for k in
+                   ("length", "radius", "mass_per_length", "E", "nu", "n_nodes", "n_gauss")}
+    c = table_of(raw, "cylinders", "")
+    CYLINDERS.check_keys(c, "cylinders")
+    sc["cylinders"] = {k: CYLINDERS.read(c, k, "cylinders")
+                       for k in ("k", "c", "barrel_mass", "rod_mass")}
+    d = table_of(raw, "drive", "")
+    DRIVE.check_keys(d, "drive")
+    t1, t2, t3 = (DRIVE.read(d, k, "drive") for k in ("t1", "t2", "t3"))
+    starts = DRIVE.read(d, "stage_starts", "drive")
     dur = t1 + t2 + t3
-    if starts[0] < 0:
-        raise SceneError(f"drive.stage_starts = {starts!r}: the first stage starts at "
-                         f"{starts[0]:g} s, allowed >= 0")
     for k in (1, 2):
         if starts[k] < starts[k - 1] + dur:
-            raise SceneError(f"drive.stage_starts = {starts!r}: stage {k + 1} starts at "
-                             f"{starts[k]:g} s before stage {k} ends at "
+            raise SceneError(f"drive.stage_starts = {short_repr(d.get('stage_starts'))}: stage "
+                             f"{k + 1} starts at {starts[k]:g} s before stage {k} ends at "
                              f"{starts[k - 1] + dur:g} s (start + t1 + t2 + t3); allowed "
                              f">= {starts[k - 1] + dur:g} s")
-    slew = number(d, "slew_angle_deg", "drive", -90.0, lo=-180.0, hi=180.0)
+    slew = DRIVE.read(d, "slew_angle_deg", "drive")
     if slew == 0.0:
         raise SceneError("drive.slew_angle_deg = 0: must be non-zero, allowed [-180, 180] deg "
                          "(set the slew stage's angle; PD -90)")
     sc["drive"] = {"t1": t1, "t2": t2, "t3": t3, "stage_starts": [float(x) for x in starts],
-                   "cyl1_stroke": number(d, "cyl1_stroke", "drive", 1.328, lo=0.0, lo_open=True),
+                   "cyl1_stroke": DRIVE.read(d, "cyl1_stroke", "drive"),
                    "slew_angle_deg": slew,
-                   "cyl2_stroke": number(d, "cyl2_stroke", "drive", 1.242, lo=0.0, lo_open=True)}
-    r = raw.get("rest", {})
-    check_keys(r, {"k", "c"}, "rest")
-    sc["rest"] = {"k": number(r, "k", "rest", 1e7, lo=0.0), "c": number(r, "c", "rest", 1e4, lo=0.0)}
-    e = raw.get("effects", {})
-    check_keys(e, {"gravity", "filtering"}, "effects")
-    sc["effects"] = {"gravity": boolean(e, "gravity", "effects", True),
-                     "filtering": boolean(e, "filtering", "effects", True)}
-    f = raw.get("filtering", {})
-    check_keys(f, {"h"}, "filtering")
-    sc["filtering"] = {"h": number(f, "h", "filtering", 0.005, lo=0.0, lo_open=True)}
-    g = raw.get("gravity", {})
-    check_keys(g, {"g"}, "gravity")
-    sc["gravity"] = {"g": number(g, "g", "gravity", 9.81, lo=0.0, lo_open=True)}
+                   "cyl2_stroke": DRIVE.read(d, "cyl2_stroke", "drive")}
+    r = table_of(raw, "rest", "")
+    REST.check_keys(r, "rest")
+    sc["rest"] = {"k": REST.read(r, "k", "rest"), "c": REST.read(r, "c", "rest")}
+    e = table_of(raw, "effects", "")
+    EFFECTS.check_keys(e, "effects")
+    sc["effects"] = {"gravity": EFFECTS.read(e, "gravity", "effects"),
+                     "filtering": EFFECTS.read(e, "filtering", "effects")}
+    f = table_of(raw, "filtering", "")
+    FILTERING.check_keys(f, "filtering")
+    sc["filtering"] = {"h": FILTERING.read(f, "h", "filtering")}
+    g = table_of(raw, "gravity", "")
+    GRAVITY.check_keys(g, "gravity")
+    sc["gravity"] = {"g": GRAVITY.read(g, "g", "gravity")}
     _check_geometry(sc)
     return sc
 

@@ -612,7 +612,8 @@ def _initial_equilibrium(ts: TelescopicSystem, t: float):
 
 def simulate_telescopic(p: TelescopicParams, t_end: float = 20.0, n_output: int = 201,
                         rtol: float = 1e-6, atol: float = 1e-7, progress=None,
-                        solver: dict | None = None, scene: dict | None = None):
+                        solver: dict | None = None, scene: dict | None = None,
+                        checkpoint=None):
     """Run the telescopic scene from its static equilibrium and return a Result with the
     public outputs of the telescopic contract (tip kinematics, piston stroke, cylinder forces,
     contact-point resultants, contact coordinates, constraint violation; with friction also the
@@ -620,20 +621,24 @@ def simulate_telescopic(p: TelescopicParams, t_end: float = 20.0, n_output: int 
     by arc P1, P2, P3 as in sim_core.physics.contact) and the signed friction coefficient per region).
     ``solver``: a validated [solver] table (:func:`sim_core.scene.fields.solver_table`); its entries
     (method, max_step, max_wall_s, ...) take precedence over the keyword arguments.  ``scene``:
-    the validated scene the result records (a summary of ``p`` where None)."""
+    the validated scene the result records (a summary of ``p`` where None).  ``checkpoint``: a
+    :class:`sim_core.checkpoint.Checkpointer` the integration writes to and resumes from (the
+    rigid-boom limit has none)."""
     from sim_core.integrate.driver import integrate, run_with_partial
     sol = {"t_end": t_end, "rtol": rtol, "atol": atol, "n_output": n_output, **(solver or {})}
     if not p.flexible:
+        if checkpoint is not None:
+            checkpoint.unsupported("effects.flexible = false (the rigid-boom limit)")
         from sim_core.systems.telescopic.rigid import RigidTelescopic
         return RigidTelescopic(p).simulate(sol["t_end"], sol["n_output"], sol["rtol"], sol["atol"],
-                                          scene=scene)
+                                          scene=scene, max_wall_s=sol.get("max_wall_s"))
     ts = build_telescopic(p)
     m = ts.model
     z0, _ = initial_equilibrium(ts)
     y0 = np.concatenate([z0, 0 * z0])
     from sim_core.systems.telescopic.energy_audit import telescopic_energy_check
     return run_with_partial(
-        lambda: integrate(m, y0, sol["t_end"], sol, progress),
+        lambda: integrate(m, y0, sol["t_end"], sol, progress, checkpoint),
         lambda t, ys, stats, err: _telescopic_result(ts, t, ys, stats, err, scene),
         check=lambda res: telescopic_energy_check(ts, res))
 

@@ -18,7 +18,7 @@ of the inertia forces, which does no work on the material kinetic energy T
   the level of the integrator's error.
 * ``P_friction = Q_dot . F_friction <= 0`` (Section 8.3: -mu(s_dot) N s_dot on each contact
   coordinate; mu is odd in s_dot), the friction dissipation.
-* ``P_filter = Q_dot . (F_filter - M_filter Q_ddot)``: the stress filter (second seed Eq. 53,
+* ``P_filter = Q_dot . (F_filter - M_filter Q_ddot)``: the stress filter (SIMULTECH 2020 Eq. 53,
   docs/model.md#input-filter) adds a mass-like term and rate forces; treated here as an applied
   force, so T stays the material kinetic energy of the booms.  Its integral is the energy the
   filter takes out (h/2 eps_dot' D eps_dot) or stores in its mass-like term.

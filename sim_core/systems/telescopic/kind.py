@@ -26,14 +26,20 @@ def build(scene: dict):
     return build_telescopic(params) if params.flexible else RigidTelescopic(params)
 
 
-def run(scene: dict, progress=None) -> Result:
-    """The scene's fidelity: the modal ROM, the rigid limit or the flexible booms."""
+def run(scene: dict, progress=None, checkpoint=None) -> Result:
+    """The scene's fidelity: the modal ROM, the rigid limit or the flexible booms.
+    ``checkpoint`` (:class:`sim_core.checkpoint.Checkpointer` or None): the flexible booms'
+    integration writes to it and resumes from it; the modal ROM has no checkpoints (it runs in
+    a fraction of a second)."""
     sol = scene["solver"]
     params = params_from_scene(scene)
     if scene.get("model", {}).get("reduction") == "modal":
+        if checkpoint is not None:
+            checkpoint.unsupported("model.reduction = 'modal' (the modal reduced-order model)")
         return simulate_modal(params, scene["model"]["n_modes"], sol["t_end"], sol["n_output"],
-                              scene=scene)
-    return simulate_telescopic(params, progress=progress, solver=sol, scene=scene)
+                              scene=scene, max_wall_s=sol.get("max_wall_s"))
+    return simulate_telescopic(params, progress=progress, solver=sol, scene=scene,
+                               checkpoint=checkpoint)
 
 
 def describe(scene: dict) -> list[str]:
@@ -135,6 +141,7 @@ def figures(result: Result, out: Path) -> list[Path]:
 
 
 def stepper(scene: dict):
-    """The scene's model advanced step by step (sim_core.Simulation)."""
-    from sim_core.systems.telescopic.stepping import TelescopicStepper
-    return TelescopicStepper(scene)
+    """The scene's model advanced step by step (sim_core.Simulation): the full model, or the
+    modal ROM where model.reduction = "modal"."""
+    from sim_core.systems.telescopic.stepping import stepper_for
+    return stepper_for(scene)

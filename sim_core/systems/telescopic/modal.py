@@ -25,7 +25,7 @@ discretisation (n_nodes = 3 per spline element, frictionless resultants, stress 
 2. the reduced tangent stiffness K = -d(F_r + C^T lambda)/dz (``tangent_stiffness``: central
    differences, step 1e-8 max(1, max|z|), symmetrised; constraint multipliers frozen: geometric
    stiffness of the constraints included), the reduced damping
-   D = -dF_r/dz_dot (stress-filter damping, second seed Eq. 53) and the reduced mass M_r (with
+   D = -dF_r/dz_dot (stress-filter damping, SIMULTECH 2020 Eq. 53) and the reduced mass M_r (with
    the filter's (h^2/6) K mass term) are evaluated about z_s;
 3. constrained modes: K N x = omega^2 M_r N x on the null space N of the constraint Jacobian
    C = g_Q P (cylinder frozen), mass-normalised (phi^T M_r phi = 1).  Out-of-plane modes (tip
@@ -632,13 +632,15 @@ def check_params(p) -> None:
 
 
 def simulate_modal(p, n_modes: int, t_end: float, n_output: int, dt_max: float = 0.05,
-                   scene: dict | None = None):
+                   scene: dict | None = None, max_wall_s: float | None = None):
     """ROM run of the scene's cubic schedule (TelescopicParams p): Result with tip_position,
     tip_velocity, tip_deflection (m, from the static tip at the current L_s), piston_stroke (m)
     and modal_coordinates.  The piston acceleration is piecewise constant on sub-intervals of
     length <= dt_max (s), equal to the schedule's mean acceleration (v(t1) - v(t0)) / h there:
     the stroke rate is exact at the interval ends and the stroke error is at most
-    h^3 max|jerk| / 12 per interval (the same kinematics as boom_env fed with these actions)."""
+    h^3 max|jerk| / 12 per interval (the same kinematics as boom_env fed with these actions).
+    ``max_wall_s``: the wall-clock budget (s, solver.max_wall_s), checked after every output;
+    past it a SimulationError carries the outputs so far as ``.result``."""
     from sim_core.physics.drive_profiles import CubicSmoothstepSchedule
     from sim_core.result import Result
     check_params(p)
@@ -664,6 +666,15 @@ def simulate_modal(p, n_modes: int, t_end: float, n_output: int, dt_max: float =
         out["piston_stroke"].append(rom.L - p.stroke0)
         out["modal_coordinates"].append(rom.q.copy())
 
+    def result(error=None):
+        wall = time.perf_counter() - wall0
+        stats = {"wall_time_s": wall, "method": "modal ROM (exact frozen-coefficient steps)",
+                 "n_modes": n_modes, "real_time_factor": t_end / max(wall, 1e-12),
+                 "n_dof": n_modes}
+        return Result(t_out[:len(out["piston_stroke"])],
+                      {k: np.array(v, float) for k, v in out.items()}, stats,
+                      scene if scene is not None else p.summary(), error)
+
     record()
     t = 0.0
     for t_next in t_out[1:]:
@@ -674,11 +685,13 @@ def simulate_modal(p, n_modes: int, t_end: float, n_output: int, dt_max: float =
             rom.advance(float(v[k + 1] - v[k]) / h, h)
         t = t_next
         record()
-    wall = time.perf_counter() - wall0
-    stats = {"wall_time_s": wall, "method": "modal ROM (exact frozen-coefficient steps)", "n_modes": n_modes,
-             "real_time_factor": t_end / max(wall, 1e-12), "n_dof": n_modes}
-    return Result(t_out, {k: np.array(v, float) for k, v in out.items()}, stats,
-                  scene if scene is not None else p.summary(), None)
+        if (max_wall_s is not None and t < t_end
+                and time.perf_counter() - wall0 > max_wall_s):
+            exc = SimulationError(t, f"wall-clock budget solver.max_wall_s = {max_wall_s:g} s "
+                                  "exhausted", last_state=rom.q.copy())
+            exc.result = result(str(exc))
+            raise exc
+    return result()
 
 
 def main(argv=None):

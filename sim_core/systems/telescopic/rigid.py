@@ -131,9 +131,12 @@ class RigidTelescopic:
 
     # -- run --------------------------------------------------------------------------------
     def simulate(self, t_end: float, n_output: int = 201, rtol: float = 1e-6,
-                 atol: float = 1e-7, scene: dict | None = None) -> Result:
+                 atol: float = 1e-7, scene: dict | None = None,
+                 max_wall_s: float | None = None) -> Result:
         """The rigid-limit outputs at n_output times in [0, t_end]; ``scene``: the validated scene
-        the result records (a summary of the parameters where None)."""
+        the result records (a summary of the parameters where None); ``max_wall_s``: the
+        wall-clock budget of the rope coordinate's integration (s, solver.max_wall_s), past
+        which a SimulationError stops the run."""
         import time
 
         from scipy.integrate import solve_ivp
@@ -143,7 +146,17 @@ class RigidTelescopic:
         wall = time.perf_counter()
         stats = {"method": "RK45" if self.elastic else "kinematic", "n_steps": 0, "n_rhs": 0}
         if self.elastic:
-            sol = solve_ivp(self._rhs, (0.0, t_end), [self.a30, 0.0], method="RK45", t_eval=t,
+            calls = [0]
+
+            def rhs(tk, y):                        # the budget every 1000 evaluations
+                calls[0] += 1
+                if (max_wall_s is not None and calls[0] % 1000 == 0
+                        and time.perf_counter() - wall > max_wall_s):
+                    from sim_core.errors import SimulationError
+                    raise SimulationError(tk, f"wall-clock budget solver.max_wall_s = "
+                                          f"{max_wall_s:g} s exhausted", last_state=np.array(y))
+                return self._rhs(tk, y)
+            sol = solve_ivp(rhs, (0.0, t_end), [self.a30, 0.0], method="RK45", t_eval=t,
                             rtol=rtol, atol=atol)
             if not sol.success:
                 from sim_core.errors import SimulationError

@@ -1,119 +1,12 @@
 """Scene schema of the telescopic boom system (kind = "telescopic"), SI units.
 
-  kind = "telescopic", name, description
-  [solver]     t_end s (> 0), rtol (0, 1), atol (> 0), n_output (>= 2), method ("RK45", "BDF",
-               "auto"), max_step s and max_wall_s s (> 0, optional; max_wall_s: wall-clock budget,
-               stops with a partial result)
-  [booms]      count (2..6: the paper's three booms are the innermost three, larger sections
-               of the same family outside them, params.crane_sections), length m (> 0),
-               luffing_angle_deg (0..85),
-               stroke0 m (piston-rod length L_s at t = 0, > 0), L_h m (luffing point on boom 1,
-               within (0, length)), E Pa (> 0), rho kg/m^3 (> 0), n_nodes (3..33 per spline
-               element; paper 9), n_gauss (1..10)
-  [drive]      direction ("extraction"/"retraction"), v_max m/s (> 0), t_ramp s (> 0),
-               t_hold_end s (>= t_ramp)  -- the cubic schedule of Section 9 (docs/model.md#input-drive);
-               mechanism ("synchronized" default: the paper's cylinder-and-rope unit repeated
-               along the boom, every stage moves together; "sequential": one cylinder moves
-               one stage at a time, the others pinned; docs/model.md, "N-boom drives")
-               profile ("cubic" default: the keys above; "trapezoid": travel m (> 0, with
-               direction), v_max m/s, a_max m/s^2 (> 0), j_max m/s^3 (> 0, optional: a jerk-
-               limited S-curve); "table": table (rows [time s, stage length m], the first row
-               is booms.stroke0) or table_file (a CSV file of time s and stage length m,
-               relative to the scene file)), t_start s (>= 0: when the cubic or trapezoid
-               starts), max_rate m/s (> 0) and max_accel m/s^2 (> 0): the actuator's limits,
-               checked against the profile (sim_core.systems.telescopic.actuators)
-  [luffing_drive] the luffing cylinder's profile in the luffing angle of the rigid crane, from
-               booms.luffing_angle_deg: profile ("hold" default, "cubic", "trapezoid",
-               "table"), travel deg (signed), t_ramp s (> 0), t_hold_end s (>= t_ramp),
-               t_start s (>= 0), v_max deg/s (> 0), a_max deg/s^2 (> 0), j_max deg/s^3 (> 0),
-               table (rows [time s, angle deg]) or table_file, max_rate deg/s (> 0),
-               max_accel deg/s^2 (> 0); the angle stays in [0, 85] deg
-  [slew_drive] the slewing drive's profile in the slew angle about the vertical from 0 (a
-               turntable under the pivot and the cylinder base): profile, travel deg,
-               t_ramp s, t_hold_end s, t_start s, v_max deg/s, a_max deg/s^2, j_max deg/s^3,
-               table or table_file (time s, angle deg), max_rate deg/s, max_accel deg/s^2,
-               as in [luffing_drive]
-  [hoist_drive] the hoist's profile in the unstretched hoist-rope length from hoist.length
-               (at least 0.1 m): profile, travel m, t_ramp s, t_hold_end s, t_start s,
-               v_max m/s, a_max m/s^2, j_max m/s^3, table or table_file (time s, length m),
-               max_rate m/s, max_accel m/s^2, as in [luffing_drive]
-  [hoist]      with effects.payload_swing: length m (> 0, unstretched at t = 0), EA N (> 0),
-               hook_mass kg (>= 0, hangs with the payload)
-  [payload]    mass kg (>= 0)
-  [ropes]      EA N (> 0)
-  [effects]    what is off is not built (each a separate contribution to the model):
-               flexible (bool, default true; false = rigid booms, the kinematic limit of
-               sim_core.systems.telescopic.rigid: no beams, no contact constraints),
-               torsion (bool, default true; false = torsion angles held at zero, twist rows of
-               the angle constraints dropped), gravity (bool), filtering (bool: stress
-               averaging with [filtering] h), friction (bool, default false: Coulomb friction
-               on the contact coordinates, Section 8.3), contact_distribution (bool, default
-               true for 3 booms: slider-spring analysis of Section 8, output
-               slider_contact_forces; false = only the constraint resultants),
-               rope_elasticity (bool, default true: elastic tension-only ropes with [ropes] EA;
-               false = one inextensible rope constraint, output rope_tension),
-               payload_swing (bool, default false: the payload and hook hang on the elastic
-               hoist rope of [hoist] and swing; false = a point mass fixed at the tip),
-               wind (bool, default false: an effect plug-in, the drag of [wind] on the exposed
-               booms, sim_core.physics.wind),
-               mass_centre_offset (bool, default false: mass on the reference line; true =
-               the Table 2 offsets z_c = 0.045/0.044/0.043 m as a rigid offset in inertia and
-               gravity, docs/model.md#input-sections; the modal ROM tables are built without it)
-  [contact]    mu_static (>= 0), mu_dynamic (>= 0), v_eps m/s (> 0, switching speed),
-               k0 N/m (> 0, radial spring stiffness), eps m (> 0, stiffness smoothing interval),
-               slider_width m (2w, > 0 and shorter than the smallest overlap L - max L_s),
-               springs_per_quarter (1..200 springs per quarter arc and slider end),
-               radial_gap m ((0, 0.05]: sliding-block thickness between the walls; sets the
-               contact-circle radius, default 5 mm of Table 1),
-               moment_model ("rigid" default: Section 6, the contact sections' Cardan angles
-               coincide; "seat": the two bending angles tied by an elastic seat of
-               seat_stiffness N m/rad (> 0, default 1e8: a 20 mm polyamide pad, E = 3 GPa, on a
-               0.3 m x 0.3 m footprint); "couple": the bending angles free, the overlap carries
-               its moment as a force couple between its two regions),
-               friction_load ("resultant" default: the friction's normal load is the transverse
-               contact resultant |(f_t, f_b)|; "springs": the sum of the slider springs, Eq. 72
-               literally, needs contact_distribution) -- docs/validation.md says why
-  [filtering]  h s (> 0)
-  [gravity]    g m/s^2 (> 0, along -Z)
-  [model]      reduction ("none" = full model, "modal" = stroke-parametric modal ROM of
-               sim_core.systems.telescopic.modal, tables built from the full model for 3 and 5
-               booms, synchronized drive, frictionless), n_modes (1..4, in-plane modes kept by
-               the ROM; default 3)
-  [[boom]]     a crane described boom by boom, outermost first (replaces booms.length and the
-               shorthand sections; booms.count, when given, must equal the number of tables):
-               length m (> 0), E Pa (> 0, default booms.E), nu (-1..0.5, default 0.3) or G Pa
-               (> 0), rho kg/m^3 (> 0, default booms.rho), and its section table (below)
-  [boom.section] shape ("u", "box", "polygon", "properties"):
-               "u": top_arc_centre_y m, top_arc_centre_z m (>= 0), top_arc_radius m (> 0, outer
-               radius r of the top arcs), bottom_arc_radius m (outer R = y_a + r, optional),
-               wall m (> 0); "box": width m, height m (> 0), wall m (> 0), corner_radius m
-               (>= 0, outer); "polygon": n_sides (3..24) with width_across_flats m (> 0, even
-               n_sides) or circumradius m (> 0), rotation_deg deg, wall m, or contour (outer
-               vertices [[y, z], ...] in m, counter-clockwise) and wall m; "properties": A m^2,
-               I_t m^4, I_b m^4, J m^4, mass_per_length kg/m (> 0), y_c m, z_c m (mass centre,
-               default 0).  For "u", "box" and
-               "polygon" the constants come from sectionproperties (finite-element section
-               analysis: A, I_t, I_b, the St. Venant constant J, centroid); any of A m^2, I_t
-               m^4, I_b m^4, J m^4, mass_per_length kg/m, y_c m, z_c m given beside the shape
-               replaces the computed value (a mass per length with fittings, say)
-  [[overlap]]  the sliders of each overlap, outermost pair first (all or none):
-               slider_width m (> 0, default contact.slider_width), inner_slider_distance m
-               (>= 0: the inner boom's slider centre from that boom's left end; default 0),
-               outer_slider_distance m (>= 0: the outer boom's slider centre from its right
-               end; default 0), radial_gap m ((0, 0.05], default contact.radial_gap),
-               bears_on (names of the inner boom's outer-face patches the sliders bear on: "u"
-               P1, P2, P3, flange, side_right, side_left; "box" bottom, right, top, left,
-               corner_br, corner_tr, corner_tl, corner_bl; "polygon" face_1..face_n from the
-               bottom face counter-clockwise; default: P1-P3 for "u", every patch otherwise)
-  [luffing]    the luffing cylinder's mounting points (docs/model.md#input-luffing), each [X, Z]
-               or [s, b] in m: pivot m (D1 in global X and Z), pivot_on_boom m (D1 in boom 1's
-               left-section frame: axial and vertical), base m (the cylinder base D2 in global X
-               and Z), head_on_boom m (the cylinder head D3 in boom 1's left-section frame; its
-               axial coordinate is the luffing point L_h; default booms.L_h and -0.556 m)
-Geometry rules: the stroke history must keep each boom inside its neighbour: with L_s(t) the
-piston length, 0 < L_s(t) < length for all t in [0, t_end] (error names drive/booms fields);
-the two sliders of every overlap fit its shortest length, the inner boom reaches past the outer
-boom's slider, and every inner section fits inside its outer one with the stated radial gap.
+Every key is declared once in :data:`SCHEMA` (type, unit, default, allowed range, note) and read
+through the declarations (:mod:`sim_core.scene.fields`), so an error names the dotted field,
+the value and the declared range; the scene reference of the documentation is rendered from
+the same declarations.  The effect plug-ins (:mod:`sim_core.physics.plugins`) declare their
+own tables.  Rules across keys (the stroke history keeps every boom inside its neighbour, the
+sliders fit their overlaps, the sections fit inside each other, ...) are listed in
+``SCHEMA.rules`` and checked below.
 """
 
 from __future__ import annotations
@@ -124,18 +17,26 @@ from typing import Any
 import numpy as np
 
 from sim_core.errors import SceneError
+from sim_core.physics.plugins import effect_plugins
 from sim_core.scene.fields import (
+    COMPUTED,
     ERROR_CONTROLLED,
-    boolean,
+    OPTIONAL,
+    REQUIRED,
+    T_MAX,
+    Field,
+    Schema,
+    Table,
     check_keys,
-    choice,
-    number,
+    read_text,
+    short_repr,
+    solver_fields,
     solver_table,
     table_of,
     tables_of,
-    vector,
+    text_fields,
+    time_field,
 )
-from sim_core.physics.plugins import effect_plugins
 from sim_core.systems.telescopic import actuators
 from sim_core.systems.telescopic.params import (
     MAX_BOOMS,
@@ -146,47 +47,406 @@ from sim_core.systems.telescopic.params import (
     TelescopicParams,
 )
 
-_TOP = {"kind", "name", "description", "solver", "booms", "drive", "payload", "ropes", "effects",
-        "filtering", "gravity", "contact", "notes", "model", "boom", "overlap", "luffing",
-        "luffing_drive", "slew_drive", "hoist_drive", "hoist", *effect_plugins()}
-_GIVEN = ("A", "I_t", "I_b", "J", "mass_per_length", "y_c", "z_c")   # constants a table may give
-_PROFILE_KEYS = ("profile", "travel", "a_max", "j_max", "t_start", "table", "table_file",
-                 "max_rate", "max_accel")
+# -- the declarations ---------------------------------------------------------------------------
 
+#: the longest boom section, m; the farthest mounting point from the crane's base frame, m
+L_MAX, X_MAX = 100.0, 50.0
+#: the largest extent of a boom's cross-section, m
+SEC_MAX = 10.0
+#: the steel ropes' and hoist rope's axial stiffness EA, N (a thin wire to a 20-fall reeving)
+EA_RANGE = dict(lo=1e4, hi=1e11)
+#: Young's modulus, Pa: from soft polymers to ten times diamond (the nearly rigid booms of the
+#: paper's Section 9.1 have 2.1e12); density, kg/m^3: from foams to osmium
+E_RANGE, RHO_RANGE = dict(lo=1e8, hi=1e15), dict(lo=10.0, hi=1e5)
+
+TOP = Table("", (Field("kind", "choice", choices=("telescopic",)), *text_fields("telescopic")),
+            tables=("solver", "booms", "boom", "luffing", "drive", "payload", "ropes",
+                    "effects", "contact", "overlap", "filtering", "gravity", "luffing_drive",
+                    "slew_drive", "hoist_drive", "hoist", "model"))
+SOLVER = solver_fields(t_end=20.0, atol=1e-7, methods=ERROR_CONTROLLED)
+BOOMS = Table("booms", (
+    Field("count", "integer", "", COMPUTED, lo=2, hi=MAX_BOOMS,
+          default_text="3, or the number of [[boom]] tables",
+          note="sections of the crane: the paper's three booms are the innermost three, larger "
+               "sections of the same family outside them (params.crane_sections)"),
+    Field("length", "number", "m", 10.0, lo=1.0, hi=L_MAX,
+          applies="the shorthand (no [[boom]] tables)", note="every boom's length"),
+    Field("luffing_angle_deg", "number", "deg", 60.0, lo=0.0, hi=85.0,
+          note="luffing angle of the rigid crane at t = 0"),
+    Field("stroke0", "number", "m", 2.0, lo=1e-3, hi=L_MAX, hi_open=True,
+          allowed="[0.001, shortest boom length) m", note="piston-rod length L_s at t = 0"),
+    Field("L_h", "number", "m", 7.25, lo=1e-3, hi=L_MAX, hi_open=True,
+          allowed="[0.001, length of boom 1) m", note="luffing point on boom 1"),
+    Field("E", "number", "Pa", 2.1e11, **E_RANGE, note="Young's modulus of every boom"),
+    Field("rho", "number", "kg/m^3", 7850.0, **RHO_RANGE, note="density of every boom"),
+    Field("n_nodes", "integer", "", 9, lo=3, hi=33,
+          note="nodes per spline element (paper 9 = 8 sub-elements)"),
+    Field("n_gauss", "integer", "", 5, lo=1, hi=10, note="Gauss points per sub-element"),
+), note="the booms shorthand: the paper's U-section family")
+BOOM = Table("boom[]", (
+    Field("length", "number", "m", REQUIRED, lo=1.0, hi=L_MAX),
+    Field("E", "number", "Pa", COMPUTED, **E_RANGE, default_text="booms.E"),
+    Field("nu", "number", "", 0.3, lo=-1.0, hi=0.5, lo_open=True, hi_open=True,
+          note="Poisson's ratio (or give G)"),
+    Field("G", "number", "Pa", COMPUTED, lo=1e7, hi=1e15, default_text="E / (2 (1 + nu))",
+          note="shear modulus (or give nu)"),
+    Field("rho", "number", "kg/m^3", COMPUTED, **RHO_RANGE, default_text="booms.rho"),
+), tables=("section",),
+    note="a crane described boom by boom, outermost first (replaces booms.length and the "
+         "shorthand sections; booms.count, when given, equals the number of tables)")
+
+_U, _BOX, _POLY, _PROPS = ("u",), ("box",), ("polygon",), ("properties",)
+_SHAPES = ("u", "box", "polygon")
+_GIVEN = ("A", "I_t", "I_b", "J", "mass_per_length", "y_c", "z_c")   # constants a table may give
+_GIVEN_NOTE = ("required with shape \"properties\"; beside another shape it replaces the value "
+               "computed from the contour")
+_CENTRE = 'from the contour; 0 with shape "properties"'
+SECTION = Table("boom[].section", (
+    Field("shape", "choice", choices=("u", "box", "polygon", "properties"),
+          note="\"u\", \"box\" and \"polygon\": the constants come from a finite-element "
+               "section analysis (sectionproperties); \"properties\": given"),
+    Field("top_arc_centre_y", "number", "m", REQUIRED, lo=0.0, hi=SEC_MAX, when=_U,
+          applies='shape = "u"'),
+    Field("top_arc_centre_z", "number", "m", REQUIRED, lo=0.0, hi=SEC_MAX, when=_U,
+          applies='shape = "u"'),
+    Field("top_arc_radius", "number", "m", REQUIRED, lo=1e-3, hi=SEC_MAX, when=_U,
+          applies='shape = "u"', note="outer radius r of the top arcs"),
+    Field("bottom_arc_radius", "number", "m", COMPUTED, lo=1e-3, hi=SEC_MAX,
+          when=_U, applies='shape = "u"', default_text="top_arc_centre_y + top_arc_radius",
+          note="outer radius R of the bottom arc"),
+    Field("width", "number", "m", REQUIRED, lo=1e-3, hi=SEC_MAX, when=_BOX,
+          applies='shape = "box"'),
+    Field("height", "number", "m", REQUIRED, lo=1e-3, hi=SEC_MAX, when=_BOX,
+          applies='shape = "box"'),
+    Field("corner_radius", "number", "m", 0.0, lo=0.0, hi=SEC_MAX / 2, when=_BOX,
+          applies='shape = "box"', note="outer radius of the corners"),
+    Field("n_sides", "integer", "", REQUIRED, lo=3, hi=24, when=_POLY,
+          applies='shape = "polygon" without contour'),
+    Field("width_across_flats", "number", "m", OPTIONAL, lo=1e-3, hi=SEC_MAX,
+          when=_POLY, applies='shape = "polygon", even n_sides',
+          note="give it or circumradius"),
+    Field("circumradius", "number", "m", OPTIONAL, lo=1e-3, hi=SEC_MAX,
+          when=_POLY, applies='shape = "polygon"', note="give it or width_across_flats"),
+    Field("rotation_deg", "number", "deg", 0.0, lo=-180.0, hi=180.0, when=_POLY,
+          applies='shape = "polygon"', note="rotation of the polygon about the section centre"),
+    Field("contour", "rows", "m", OPTIONAL, items=(3, 1000),
+          columns=((-SEC_MAX, SEC_MAX, "m"), (-SEC_MAX, SEC_MAX, "m")), when=_POLY,
+          applies='shape = "polygon"',
+          note="outer vertices [y, z], counter-clockwise (instead of n_sides)"),
+    Field("wall", "number", "m", REQUIRED, lo=1e-4, hi=0.5, when=_SHAPES,
+          applies='shape "u", "box", "polygon"', note="wall thickness"),
+    Field("A", "number", "m^2", OPTIONAL, lo=1e-8, hi=10.0, note=_GIVEN_NOTE),
+    Field("I_t", "number", "m^4", OPTIONAL, lo=1e-16, hi=100.0, note=_GIVEN_NOTE),
+    Field("I_b", "number", "m^4", OPTIONAL, lo=1e-16, hi=100.0, note=_GIVEN_NOTE),
+    Field("J", "number", "m^4", OPTIONAL, lo=1e-16, hi=100.0,
+          note="St. Venant torsion constant; " + _GIVEN_NOTE),
+    Field("mass_per_length", "number", "kg/m", OPTIONAL, lo=1e-3, hi=1e5,
+          note="default rho A; " + _GIVEN_NOTE + " (a mass with fittings, say)"),
+    Field("y_c", "number", "m", COMPUTED, lo=-SEC_MAX, hi=SEC_MAX, default_text=_CENTRE,
+          note="mass centre across the luffing plane (the section's must be 0)"),
+    Field("z_c", "number", "m", COMPUTED, lo=-SEC_MAX, hi=SEC_MAX, default_text=_CENTRE,
+          note="mass centre, vertical"),
+), note="each boom's cross-section")
+LUFFING = Table("luffing", (
+    Field("pivot", "vector", "m", [-0.556, 0.350], n=2, lo=-X_MAX, hi=X_MAX,
+          note="D1 in global X and Z"),
+    Field("pivot_on_boom", "vector", "m", [-0.956, 0.556], n=2, lo=-X_MAX, hi=X_MAX,
+          note="D1 in boom 1's left-section frame (axial, vertical)"),
+    Field("base", "vector", "m", [0.100, 0.050], n=2, lo=-X_MAX, hi=X_MAX,
+          note="the cylinder base D2 in global X and Z"),
+    Field("head_on_boom", "vector", "m", COMPUTED, n=2, lo=-X_MAX, hi=X_MAX,
+          default_text="[booms.L_h, -0.556]",
+          note="the cylinder head D3 in boom 1's left-section frame; its axial coordinate is "
+               "the luffing point L_h, in (0, length of boom 1)"),
+), note="the luffing cylinder's mounting points (docs/model.md#input-luffing)")
+
+
+def actuator_table(name: str, unit: str, travel: tuple, rate: float, accel: float,
+                   jerk: float, position: tuple, what: str) -> Table:
+    """The declared table of an actuator's drive profile (sim_core.systems.telescopic.
+    actuators): positions in ``unit`` (m or deg), travel in ``travel`` (lo, hi), rates up to
+    ``rate`` per s, accelerations up to ``accel`` per s^2, jerks up to ``jerk`` per s^3, table
+    positions in ``position`` (lo, hi)."""
+    drive = name == "drive"
+    prof = ("cubic", "trapezoid", "table") if drive else ("hold", "cubic", "trapezoid", "table")
+    cubic, trap, tab = ("cubic",), ("trapezoid",), ("table",)
+    fields = []
+    if drive:
+        fields += [
+            Field("direction", "choice", default="extraction",
+                  choices=("extraction", "retraction"), note="the sign of the stroke"),
+            Field("v_max", "number", f"{unit}/s", 0.5, lo=1e-4, hi=rate,
+                  note="peak stroke rate (cubic and trapezoid profiles)"),
+            Field("t_ramp", "number", "s", 4.0, lo=1e-3, hi=T_MAX,
+                  note="length of each ramp of the cubic schedule"),
+            Field("t_hold_end", "number", "s", 12.0, lo=1e-3, hi=T_MAX,
+                  allowed=f"[t_ramp, {T_MAX:g}] s", note="end of the constant-rate hold"),
+            Field("mechanism", "choice", default="synchronized", choices=MECHANISMS,
+                  note="\"synchronized\": the paper's cylinder-and-rope unit repeated along "
+                       "the boom, every stage moves together; \"sequential\": one cylinder "
+                       "moves one stage at a time, the others pinned (docs/model.md, \"N-boom "
+                       "drives\")"),
+        ]
+    fields += [
+        Field("profile", "choice", default="cubic" if drive else "hold", choices=prof,
+              note=("\"cubic\": the paper's schedule (Section 9); " if drive else
+                    "\"hold\": no motion; \"cubic\": the paper's schedule (Section 9); ")
+              + "\"trapezoid\": acceleration-limited, jerk-limited with j_max; \"table\": "
+                "time and position rows"),
+        Field("travel", "number", unit, REQUIRED, lo=travel[0], hi=travel[1],
+              when=trap if drive else cubic + trap,
+              applies='profile "trapezoid"' if drive else 'profile "cubic" or "trapezoid"',
+              allowed=(None if drive else
+                       f"[{travel[0]:g}, {travel[1]:g}] {unit}, not 0") or "",
+              note="stroke length, its sign from direction" if drive else "signed"),
+    ]
+    if not drive:
+        fields += [
+            Field("t_ramp", "number", "s", 4.0, lo=1e-3, hi=T_MAX, when=cubic,
+                  applies='profile "cubic"'),
+            Field("t_hold_end", "number", "s", REQUIRED, lo=1e-3, hi=T_MAX,
+                  when=cubic, applies='profile "cubic"', allowed=f"[t_ramp, {T_MAX:g}] s"),
+            Field("v_max", "number", f"{unit}/s", REQUIRED, lo=1e-4, hi=rate,
+                  when=trap, applies='profile "trapezoid"'),
+        ]
+    fields += [
+        Field("a_max", "number", f"{unit}/s^2", REQUIRED, lo=1e-4, hi=accel,
+              when=trap, applies='profile "trapezoid"'),
+        Field("j_max", "number", f"{unit}/s^3", OPTIONAL, lo=1e-4, hi=jerk,
+              when=trap, applies='profile "trapezoid"', note="a jerk-limited S-curve"),
+        time_field("t_start", 0.0, when=cubic + trap, applies='profile "cubic" or "trapezoid"',
+                   note="when the motion starts"),
+        Field("table", "rows", unit, OPTIONAL, items=(2, 100000),
+              columns=((0.0, T_MAX, "s"), (position[0], position[1], unit)), when=tab,
+              applies='profile "table"',
+              note="rows [time, position], times increasing"
+                   + ("; the first position is booms.stroke0" if drive else "")
+                   + " (or table_file)"),
+        Field("table_file", "string", default=OPTIONAL, when=tab, applies='profile "table"',
+              note="a CSV file of time and position, relative to the scene file"),
+        Field("max_rate", "number", f"{unit}/s", OPTIONAL, lo=1e-4, hi=rate,
+              note="the actuator's rate limit, checked against the profile"),
+        Field("max_accel", "number", f"{unit}/s^2", OPTIONAL, lo=1e-4, hi=accel,
+              note="the actuator's acceleration limit, checked against the profile"),
+    ]
+    return Table(name, tuple(fields), note=what)
+
+
+DRIVE = actuator_table("drive", "m", (1e-3, L_MAX), 5.0, 10.0, 100.0, (0.0, L_MAX),
+                       "the telescopic cylinders: the stage length L_s (m) from booms.stroke0")
+LUFFING_DRIVE = actuator_table(
+    "luffing_drive", "deg", (-85.0, 85.0), 30.0, 100.0, 1000.0, (0.0, 85.0),
+    "the luffing cylinder: the luffing angle of the rigid crane (deg) from "
+    "booms.luffing_angle_deg; it stays in [0, 85] deg")
+SLEW_DRIVE = actuator_table(
+    "slew_drive", "deg", (-3600.0, 3600.0), 60.0, 100.0, 1000.0, (-3600.0, 3600.0),
+    "the slewing drive: the slew angle about the vertical (deg) from 0, a turntable under the "
+    "pivot and the cylinder base")
+HOIST_DRIVE = actuator_table(
+    "hoist_drive", "m", (-1000.0, 1000.0), 10.0, 20.0, 200.0, (0.1, 1000.0),
+    "the hoist: the unstretched hoist-rope length (m) from hoist.length; it stays at least "
+    "0.1 m")
+ACTUATOR_TABLES = {t.path: t for t in (DRIVE, LUFFING_DRIVE, SLEW_DRIVE, HOIST_DRIVE)}
+
+PAYLOAD = Table("payload", (
+    # the heaviest lifts of mobile cranes are ~1200 t
+    Field("mass", "number", "kg", 25000.0, lo=0.0, hi=2e6, note="the payload at the tip"),
+))
+ROPES = Table("ropes", (
+    Field("EA", "number", "N", 1e8, **EA_RANGE, note="axial stiffness of the telescoping ropes"),
+))
+
+
+def _effects_table() -> Table:
+    plugins = effect_plugins()
+    return Table("effects", (
+        Field("flexible", "boolean", default=True,
+              note="false = rigid booms, the kinematic limit of sim_core.systems.telescopic."
+                   "rigid: no beams, no contact constraints"),
+        Field("torsion", "boolean", default=True,
+              note="false = torsion angles held at zero, the twist rows of the angle "
+                   "constraints dropped"),
+        Field("gravity", "boolean", default=True),
+        Field("filtering", "boolean", default=True, note="stress averaging over [filtering] h"),
+        Field("friction", "boolean", default=False,
+              note="Coulomb friction on the contact coordinates (Section 8.3)"),
+        Field("contact_distribution", "boolean", default=COMPUTED,
+              default_text="true for 3 booms or [[boom]] tables, else false",
+              note="slider-spring analysis of Section 8, output slider_contact_forces; false = "
+                   "only the constraint resultants"),
+        Field("rope_elasticity", "boolean", default=True,
+              note="elastic tension-only ropes with [ropes] EA; false = one inextensible rope "
+                   "constraint, output rope_tension"),
+        Field("mass_centre_offset", "boolean", default=False,
+              note="true = the Table 2 offsets z_c = 0.045/0.044/0.043 m as a rigid offset in "
+                   "inertia and gravity (docs/model.md#input-sections); the modal tables are "
+                   "built without it"),
+        Field("payload_swing", "boolean", default=False,
+              note="the payload and hook hang on the elastic hoist rope of [hoist] and swing; "
+                   "false = a point mass fixed at the tip"),
+        *(Field(name, "boolean", default=False,
+                note=f"an effect plug-in ({p.validate.__module__}): {p.description}")
+          for name, p in plugins.items()),
+    ), note="what is off is not built (each a separate contribution to the model)")
+
+
+EFFECTS = _effects_table()
+CONTACT = Table("contact", (
+    Field("mu_static", "number", "", 0.15, lo=0.0, hi=2.0,
+          note="static friction coefficient of the sliders"),
+    Field("mu_dynamic", "number", "", 0.1, lo=0.0, hi=2.0,
+          note="dynamic friction coefficient of the sliders"),
+    Field("v_eps", "number", "m/s", 0.01, lo=1e-6, hi=1.0,
+          note="switching speed of the friction law"),
+    Field("k0", "number", "N/m", 1e9, lo=1e4, hi=1e12, note="radial slider-spring stiffness"),
+    Field("eps", "number", "m", 1e-6, lo=1e-9, hi=1e-2,
+          note="smoothing interval of the spring stiffness"),
+    Field("slider_width", "number", "m", 0.3, lo=1e-3, hi=5.0,
+          allowed="[0.001, 5] m, and shorter than the smallest overlap",
+          note="2w, the sliders' length along the boom"),
+    Field("springs_per_quarter", "integer", "", 20, lo=1, hi=200,
+          note="springs per quarter arc and slider end"),
+    # a gap wider than 50 mm would put the contact circle of the 75 mm top arcs near their
+    # centre (Table 1 radii)
+    Field("radial_gap", "number", "m", 0.005, lo=1e-4, hi=0.05,
+          note="sliding-block thickness between the walls; sets the contact-circle radius "
+               "(Table 1: 5 mm)"),
+    Field("moment_model", "choice", default="rigid", choices=("rigid", "seat", "couple"),
+          note="\"rigid\": Section 6, the contact sections' Cardan angles coincide; \"seat\": "
+               "the two bending angles tied by an elastic seat of seat_stiffness; \"couple\": "
+               "the bending angles free, the overlap carries its moment as a force couple"),
+    # a polyamide pad (E = 3 GPa) 20 mm thick on a 0.3 m x 0.3 m footprint rocking about its
+    # centre: E/t * b (2w)^3 / 12 = 1.0e8 N m/rad
+    Field("seat_stiffness", "number", "N m/rad", 1e8, lo=1e3, hi=1e12,
+          applies='moment_model = "seat"',
+          note="default: a 20 mm polyamide pad, E = 3 GPa, on a 0.3 m x 0.3 m footprint"),
+    Field("friction_load", "choice", default="resultant", choices=("resultant", "springs"),
+          note="\"resultant\": the friction's normal load is the transverse contact resultant; "
+               "\"springs\": the sum of the slider springs (Eq. 72 literally, needs "
+               "contact_distribution); docs/validation.md says why"),
+), note="the sliders between the booms")
+OVERLAP = Table("overlap[]", (
+    Field("slider_width", "number", "m", COMPUTED, lo=1e-3, hi=5.0,
+          default_text="contact.slider_width", allowed="[0.001, 5] m, and fits the overlap"),
+    Field("inner_slider_distance", "number", "m", 0.0, lo=0.0, hi=L_MAX,
+          note="the inner boom's slider centre from that boom's left end"),
+    Field("outer_slider_distance", "number", "m", 0.0, lo=0.0, hi=L_MAX,
+          note="the outer boom's slider centre from its right end"),
+    Field("radial_gap", "number", "m", COMPUTED, lo=1e-4, hi=0.05,
+          default_text="contact.radial_gap"),
+    Field("bears_on", "strings", default=OPTIONAL, items=(1, 64),
+          note="the inner boom's outer-face patches the sliders bear on: \"u\" P1, P2, P3, "
+               "flange, side_right, side_left; \"box\" bottom, right, top, left, corner_br, "
+               "corner_tr, corner_tl, corner_bl; \"polygon\" face_1..face_n from the bottom "
+               "face counter-clockwise (default: P1-P3 for \"u\", every patch otherwise)"),
+), note="the sliders of each overlap, outermost pair first (all or none)")
+FILTERING = Table("filtering", (
+    Field("h", "number", "s", 0.01, lo=1e-4, hi=1.0,
+          note="stress-averaging window (SIMULTECH 2020 Eq. 53)"),
+))
+GRAVITY = Table("gravity", (
+    Field("g", "number", "m/s^2", 9.81, lo=0.0, hi=100.0, lo_open=True, note="along -Z"),
+))
+HOIST = Table("hoist", (
+    Field("length", "number", "m", 10.0, lo=0.1, hi=1000.0, note="unstretched, at t = 0"),
+    Field("EA", "number", "N", 2e8, **EA_RANGE, note="axial stiffness of the hoist rope"),
+    Field("hook_mass", "number", "kg", 500.0, lo=0.0, hi=1e5, note="hangs with the payload"),
+), note="the hoist rope of effects.payload_swing")
+MODEL = Table("model", (
+    Field("reduction", "choice", default="none", choices=("none", "modal"),
+          note="\"none\" = full model; \"modal\" = the stroke-parametric modal ROM of "
+               "sim_core.systems.telescopic.modal (tables built from the full model for 3 and 5 "
+               "booms, synchronized drive, frictionless)"),
+    Field("n_modes", "integer", "", 3, lo=1, hi=4, note="in-plane modes kept by the ROM"),
+))
+
+
+def _plugin_tables() -> tuple[Table, ...]:
+    return tuple(p.fields for p in effect_plugins().values() if p.fields is not None)
+
+
+SCHEMA = Schema(
+    "telescopic", 'Telescopic scenes (`kind = "telescopic"`)',
+    "sim_core.systems.telescopic.schema.validate_telescopic",
+    (TOP, SOLVER, BOOMS, BOOM, SECTION, LUFFING, DRIVE, PAYLOAD, ROPES, EFFECTS, CONTACT,
+     OVERLAP, FILTERING, GRAVITY, LUFFING_DRIVE, SLEW_DRIVE, HOIST_DRIVE, HOIST, MODEL,
+     *_plugin_tables()),
+    rules=(
+        "The stroke history keeps every boom inside its neighbour: 0 < L_s(t) < the shortest "
+        "boom length for t in [0, solver.t_end] (the cubic drive: v_max t_hold_end bounded by "
+        "the room left).",
+        "booms.length and [[boom]] tables exclude each other; booms.count, when given, equals "
+        "the number of [[boom]] tables; a [[boom]] table gives nu or G, not both.",
+        "The two sliders of every overlap fit its shortest length, the inner boom reaches past "
+        "the outer boom's slider, and every inner section fits inside its outer one with the "
+        "stated radial gap; [[overlap]] has one table per pair of adjacent booms or none.",
+        "A boom's section is symmetric about the luffing plane (its mass centre y_c = 0); its "
+        "outer contour is at most 1000 walls long (width to wall about 250).",
+        "luffing.head_on_boom[0] and booms.L_h agree where both are given; the luffing "
+        "cylinder is at least 0.1 m long with a lever of at least 0.01 m about the pivot D1 at "
+        "every angle of the luffing profile.",
+        "drive.profile \"trapezoid\" or \"table\" needs drive.mechanism = \"synchronized\"; a "
+        "drive table's first length equals booms.stroke0 where both are given.",
+        "A profile's keys belong to its kind (travel, t_ramp, t_hold_end to \"cubic\"; travel, "
+        "v_max, a_max, j_max to \"trapezoid\"; one of table or table_file to \"table\"); a "
+        "travel is not 0; the profile's largest rate and acceleration stay within max_rate "
+        "and max_accel.",
+        "The slew keeps the boom's axis more than 15 deg from the lateral axis of the initial "
+        "luffing plane, where the booms' Cardan angles are singular.",
+        "[hoist] and [hoist_drive] need effects.payload_swing = true; a swinging payload needs "
+        "a positive payload.mass + hoist.hook_mass.",
+        "effects.flexible = false (the rigid limit): booms.count 2 or 3, the synchronized "
+        "drive, no friction, moment_model \"rigid\", no [[boom]] tables, no luffing, slewing or "
+        "swinging payload.",
+        "contact.friction_load = \"springs\" needs effects.contact_distribution = true, which "
+        "needs sections with a contour (not \"properties\").",
+        "model.reduction = \"modal\": booms.count 3 or 5, the synchronized drive on the cubic "
+        "profile from t = 0, no friction, moment_model \"rigid\", payload.mass, "
+        "booms.luffing_angle_deg and the stroke history within the modal tables' ranges (3 "
+        "booms: 20-30 t, 45-75 deg, L_s in [1.75, 8.25] m), the crane the tables were built "
+        "from (the defaults of booms.length, L_h, E, rho, ropes.EA, gravity, filtering, "
+        "torsion, rope_elasticity, flexible), no [[boom]] tables, no mass-centre offset, effect "
+        "plug-in, luffing, slewing or swinging payload.",
+        "An effect plug-in's table ([wind]) needs its switch effects.<name> = true; the wind "
+        "needs sections with a contour.",
+    ))
+
+
+# -- the validator --------------------------------------------------------------------------
 
 def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
-    check_keys(raw, _TOP, "scene")
-    sc: dict[str, Any] = {"kind": "telescopic", "name": str(raw.get("name", "telescopic")),
-                          "description": str(raw.get("description", "")), "source": source}
-    sc["solver"] = solver_table(raw.get("solver", {}), t_end=20.0, atol=1e-7,
+    plugins = effect_plugins()
+    TOP.check_keys(raw, "scene", extra=plugins)
+    TOP.read(raw, "kind", "scene")
+    sc: dict[str, Any] = {"kind": "telescopic"}
+    read_text(raw, TOP, sc, "telescopic")
+    sc["source"] = source
+    sc["solver"] = solver_table(table_of(raw, "solver", ""), t_end=20.0, atol=1e-7,
                                 methods=ERROR_CONTROLLED)
-    b = raw.get("booms", {})
-    check_keys(b, {"count", "length", "luffing_angle_deg", "stroke0", "L_h", "E", "rho",
-                   "n_nodes", "n_gauss"}, "booms")
+    b = table_of(raw, "booms", "")
+    BOOMS.check_keys(b, "booms")
     boom_tables = tables_of(raw, "boom")
     if boom_tables and "length" in b:
         raise SceneError("booms.length with [[boom]] tables: every [[boom]] gives its own length "
                          "(allowed: booms.length or [[boom]] lengths, not both)")
     if boom_tables and b.get("count", len(boom_tables)) != len(boom_tables):
-        raise SceneError(f"booms.count = {b['count']!r} with {len(boom_tables)} [[boom]] tables: "
-                         "the count must equal the number of tables (or be left out)")
-    # physical ranges: from soft polymers to ten times diamond, from foams to osmium
-    E = number(b, "E", "booms", 2.1e11, lo=1e8, hi=1e15)
-    rho = number(b, "rho", "booms", 7850.0, lo=10.0, hi=1e5)
+        raise SceneError(f"booms.count = {short_repr(b['count'])} with {len(boom_tables)} "
+                         "[[boom]] tables: the count must equal the number of tables (or be "
+                         "left out)")
+    E = BOOMS.read(b, "E", "booms")
+    rho = BOOMS.read(b, "rho", "booms")
     if boom_tables:
         sc["boom"] = _check_booms(boom_tables, E, rho)
         L1, Lmin = sc["boom"][0]["length"], min(x["length"] for x in sc["boom"])
     else:
-        L1 = Lmin = number(b, "length", "booms", 10.0, lo=0.0, lo_open=True)
-    sc["booms"] = {"count": number(b, "count", "booms", len(boom_tables) or 3, lo=2,
-                                   hi=MAX_BOOMS, integer=True),
-                   "luffing_angle_deg": number(b, "luffing_angle_deg", "booms", 60.0, lo=0.0, hi=85.0),
-                   "stroke0": number(b, "stroke0", "booms", 2.0, lo=0.0, hi=Lmin, lo_open=True,
-                                     hi_open=True),
-                   "L_h": number(b, "L_h", "booms", 7.25, lo=0.0, hi=L1, lo_open=True, hi_open=True),
+        L1 = Lmin = BOOMS.read(b, "length", "booms")
+    sc["booms"] = {"count": BOOMS.read(b, "count", "booms", default=len(boom_tables) or 3),
+                   "luffing_angle_deg": BOOMS.read(b, "luffing_angle_deg", "booms"),
+                   "stroke0": BOOMS.read(b, "stroke0", "booms", hi=Lmin, hi_open=True),
+                   "L_h": BOOMS.read(b, "L_h", "booms", hi=L1, hi_open=True),
                    "E": E, "rho": rho,
-                   "n_nodes": number(b, "n_nodes", "booms", 9, lo=3, hi=33, integer=True),
-                   "n_gauss": number(b, "n_gauss", "booms", 5, lo=1, hi=10, integer=True)}
+                   "n_nodes": BOOMS.read(b, "n_nodes", "booms"),
+                   "n_gauss": BOOMS.read(b, "n_gauss", "booms")}
     if not boom_tables:
         sc["booms"] = {"count": sc["booms"]["count"], "length": L1,
                        **{k: v for k, v in sc["booms"].items() if k != "count"}}
@@ -194,16 +454,15 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
     if lf:
         sc["luffing"] = _check_luffing(lf, b, sc["booms"]["L_h"], L1)
         sc["booms"]["L_h"] = sc["luffing"]["head_on_boom"][0]
-    d = raw.get("drive", {})
-    check_keys(d, {"direction", "v_max", "t_ramp", "t_hold_end", "mechanism", *_PROFILE_KEYS},
-               "drive")
-    t_ramp = number(d, "t_ramp", "drive", 4.0, lo=0.0, lo_open=True)
-    sc["drive"] = {"direction": choice(d, "direction", "drive", ("extraction", "retraction"), "extraction"),
-                   "v_max": number(d, "v_max", "drive", 0.5, lo=0.0, lo_open=True),
+    d = table_of(raw, "drive", "")
+    check_keys(d, DRIVE.all_keys(), "drive")
+    t_ramp = DRIVE.read(d, "t_ramp", "drive")
+    sc["drive"] = {"direction": DRIVE.read(d, "direction", "drive"),
+                   "v_max": DRIVE.read(d, "v_max", "drive"),
                    "t_ramp": t_ramp,
-                   "t_hold_end": number(d, "t_hold_end", "drive", 12.0, lo=t_ramp),
-                   "mechanism": choice(d, "mechanism", "drive", MECHANISMS, "synchronized")}
-    sc["drive"].update(_check_actuator(d, "drive", "cubic"))
+                   "t_hold_end": DRIVE.read(d, "t_hold_end", "drive", lo=t_ramp),
+                   "mechanism": DRIVE.read(d, "mechanism", "drive")}
+    sc["drive"].update(_check_actuator(d, "drive"))
     L = Lmin
     what = "booms.length" if not boom_tables else "the shortest [[boom]] length"
     if sc["drive"]["profile"] == "cubic":
@@ -211,10 +470,11 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
         sign = 1 if sc["drive"]["direction"] == "extraction" else -1
         end = sc["booms"]["stroke0"] + sign * travel
         if not 0.0 < end < L:
+            room = (L - sc["booms"]["stroke0"]) if sign > 0 else sc["booms"]["stroke0"]
             raise SceneError(f"drive: the stroke history moves L_s from {sc['booms']['stroke0']:g} m to "
                              f"{end:g} m, outside the allowed (0, {L:g}) m ({what}): a boom would "
                              f"leave its neighbour; reduce drive.v_max or drive.t_hold_end "
-                             f"(v_max * t_hold_end <= {(L - sc['booms']['stroke0']) if sign > 0 else sc['booms']['stroke0']:g} m)")
+                             f"(v_max * t_hold_end <= {room:g} m)")
         ls_lo, ls_hi = sorted((sc["booms"]["stroke0"], end))
     else:
         if sc["drive"]["profile"] == "table":
@@ -237,34 +497,28 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
                              f"({what}): a boom would leave its neighbour")
         actuators.check_limits("drive", sc["drive"], prof, sc["solver"]["t_end"])
         end = ls_hi if ls_hi != sc["booms"]["stroke0"] else ls_lo
-    pl = raw.get("payload", {})
-    check_keys(pl, {"mass"}, "payload")
-    # the heaviest lifts of mobile cranes are ~1200 t
-    sc["payload"] = {"mass": number(pl, "mass", "payload", 25000.0, lo=0.0, hi=2e6)}
-    r = raw.get("ropes", {})
-    check_keys(r, {"EA"}, "ropes")
-    sc["ropes"] = {"EA": number(r, "EA", "ropes", 1e8, lo=0.0, lo_open=True)}
-    e = raw.get("effects", {})
-    plugins = effect_plugins()
-    check_keys(e, {"gravity", "filtering", "friction", "contact_distribution", "torsion",
-                   "rope_elasticity", "flexible", "mass_centre_offset", "payload_swing",
-                   *plugins}, "effects")
+    pl = table_of(raw, "payload", "")
+    PAYLOAD.check_keys(pl, "payload")
+    sc["payload"] = {"mass": PAYLOAD.read(pl, "mass", "payload")}
+    r = table_of(raw, "ropes", "")
+    ROPES.check_keys(r, "ropes")
+    sc["ropes"] = {"EA": ROPES.read(r, "EA", "ropes")}
+    e = table_of(raw, "effects", "")
+    EFFECTS.check_keys(e, "effects")
     three = sc["booms"]["count"] == 3 or bool(boom_tables)
-    sc["effects"] = {"flexible": boolean(e, "flexible", "effects", True),
-                     "torsion": boolean(e, "torsion", "effects", True),
-                     "gravity": boolean(e, "gravity", "effects", True),
-                     "filtering": boolean(e, "filtering", "effects", True),
-                     "friction": boolean(e, "friction", "effects", False),
-                     "contact_distribution": boolean(e, "contact_distribution", "effects", three),
-                     "rope_elasticity": boolean(e, "rope_elasticity", "effects", True),
-                     "mass_centre_offset": boolean(e, "mass_centre_offset", "effects", False),
-                     "payload_swing": boolean(e, "payload_swing", "effects", False)}
+    sc["effects"] = {k: EFFECTS.read(e, k, "effects", **({"default": three} if
+                                                          k == "contact_distribution" else {}))
+                     for k in ("flexible", "torsion", "gravity", "filtering", "friction",
+                               "contact_distribution", "rope_elasticity", "mass_centre_offset",
+                               "payload_swing")}
     for name in plugins:                # effect plug-ins (sim_core.physics.plugins): off unless on
         if name in e:
-            sc["effects"][name] = boolean(e, name, "effects", False)
+            sc["effects"][name] = EFFECTS.read(e, name, "effects")
     eff = sc["effects"]
-    if boom_tables and not (eff["flexible"]
-                            and raw.get("model", {}).get("reduction", "none") == "none"):
+    mo = table_of(raw, "model", "")
+    MODEL.check_keys(mo, "model")
+    reduction = MODEL.read(mo, "reduction", "model")
+    if boom_tables and not (eff["flexible"] and reduction == "none"):
         raise SceneError("[[boom]] tables with effects.flexible = false or model.reduction = "
                          "'modal': the rigid limit and the modal tables are built for the paper's "
                          "crane (allowed: the booms shorthand, or flexible booms with "
@@ -278,31 +532,12 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
         if eff["friction"]:
             raise SceneError("effects.friction = true with effects.flexible = false: rigid contact "
                              "reactions are statically indeterminate (allowed: friction = false)")
-    c = raw.get("contact", {})
-    check_keys(c, {"mu_static", "mu_dynamic", "v_eps", "k0", "eps", "slider_width",
-                   "springs_per_quarter", "radial_gap", "moment_model", "seat_stiffness",
-                   "friction_load"}, "contact")
-    sc["contact"] = {"mu_static": number(c, "mu_static", "contact", 0.15, lo=0.0),
-                     "mu_dynamic": number(c, "mu_dynamic", "contact", 0.1, lo=0.0),
-                     "v_eps": number(c, "v_eps", "contact", 0.01, lo=0.0, lo_open=True),
-                     "k0": number(c, "k0", "contact", 1e9, lo=0.0, lo_open=True),
-                     "eps": number(c, "eps", "contact", 1e-6, lo=0.0, lo_open=True),
-                     "slider_width": number(c, "slider_width", "contact", 0.3, lo=0.0,
-                                            lo_open=True),
-                     "springs_per_quarter": number(c, "springs_per_quarter", "contact", 20,
-                                                   lo=1, hi=200, integer=True),
-                     # a gap wider than 50 mm would put the contact circle of the 75 mm top arcs
-                     # near their centre (Table 1 radii)
-                     "radial_gap": number(c, "radial_gap", "contact", 0.005, lo=0.0, hi=0.05,
-                                          lo_open=True),
-                     "moment_model": choice(c, "moment_model", "contact",
-                                            ("rigid", "seat", "couple"), "rigid"),
-                     # a polyamide pad (E = 3 GPa) 20 mm thick on a 0.3 m x 0.3 m footprint
-                     # rocking about its centre: E/t * b (2w)^3 / 12 = 1.0e8 N m/rad
-                     "seat_stiffness": number(c, "seat_stiffness", "contact", 1e8, lo=0.0,
-                                              lo_open=True),
-                     "friction_load": choice(c, "friction_load", "contact",
-                                             ("resultant", "springs"), "resultant")}
+    c = table_of(raw, "contact", "")
+    CONTACT.check_keys(c, "contact")
+    sc["contact"] = {k: CONTACT.read(c, k, "contact") for k in
+                     ("mu_static", "mu_dynamic", "v_eps", "k0", "eps", "slider_width",
+                      "springs_per_quarter", "radial_gap", "moment_model", "seat_stiffness",
+                      "friction_load")}
     cc = sc["contact"]
     if cc["friction_load"] == "springs" and not eff["contact_distribution"]:
         raise SceneError("contact.friction_load = 'springs' with effects.contact_distribution = "
@@ -324,26 +559,25 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
             raise SceneError(f"contact.slider_width = {sc['contact']['slider_width']:g} m does not "
                              f"fit the shortest overlap of adjacent booms, booms.length - max L_s "
                              f"= {overlap:g} m (allowed: 0 < slider_width < {overlap:g} m)")
-    f = raw.get("filtering", {})
-    check_keys(f, {"h"}, "filtering")
-    sc["filtering"] = {"h": number(f, "h", "filtering", 0.01, lo=0.0, lo_open=True)}
-    g = raw.get("gravity", {})
-    check_keys(g, {"g"}, "gravity")
-    sc["gravity"] = {"g": number(g, "g", "gravity", 9.81, lo=0.0, lo_open=True)}
+    f = table_of(raw, "filtering", "")
+    FILTERING.check_keys(f, "filtering")
+    sc["filtering"] = {"h": FILTERING.read(f, "h", "filtering")}
+    g = table_of(raw, "gravity", "")
+    GRAVITY.check_keys(g, "gravity")
+    sc["gravity"] = {"g": GRAVITY.read(g, "g", "gravity")}
     # the other actuators (sim_core.systems.telescopic.actuators) and the hoisted payload
     t_end = sc["solver"]["t_end"]
     theta0 = sc["booms"]["luffing_angle_deg"]
     for table in ("luffing_drive", "slew_drive", "hoist_drive"):
         tb = table_of(raw, table, "")
-        check_keys(tb, {*_PROFILE_KEYS, "v_max", "t_ramp", "t_hold_end"}, table)
+        T = ACTUATOR_TABLES[table]
+        check_keys(tb, T.all_keys(), table)
         if tb:
-            sc[table] = _check_actuator(tb, table, "hold")
+            sc[table] = _check_actuator(tb, table)
     h = table_of(raw, "hoist", "")
-    check_keys(h, {"length", "EA", "hook_mass"}, "hoist")
+    HOIST.check_keys(h, "hoist")
     if eff["payload_swing"] or h:
-        sc["hoist"] = {"length": number(h, "length", "hoist", 10.0, lo=0.0, lo_open=True),
-                       "EA": number(h, "EA", "hoist", 2e8, lo=0.0, lo_open=True),
-                       "hook_mass": number(h, "hook_mass", "hoist", 500.0, lo=0.0)}
+        sc["hoist"] = {k: HOIST.read(h, k, "hoist") for k in ("length", "EA", "hook_mass")}
     if ("hoist_drive" in sc or "hoist" in sc) and not eff["payload_swing"]:
         raise SceneError("[hoist] or [hoist_drive] with effects.payload_swing = false: the hoist "
                          "rope exists only with the swinging payload (allowed: "
@@ -371,12 +605,16 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
         if lo < 0.1:
             raise SceneError(f"hoist_drive: the hoist rope's length drops to {lo:.4g} m (allowed: "
                              "at least 0.1 m)")
-    if any(k in sc for k in ("luffing_drive", "slew_drive")) or eff["payload_swing"]:
-        if not eff["flexible"] or raw.get("model", {}).get("reduction", "none") != "none":
-            raise SceneError("luffing, slewing or a swinging payload with effects.flexible = "
-                             "false or model.reduction = 'modal': the rigid limit and the modal "
-                             "tables have a fixed luffing angle and a fixed payload (allowed: "
-                             "flexible booms with model.reduction = 'none')")
+    moving = [k for k in ("luffing_drive", "slew_drive") if k in sc]
+    if moving or eff["payload_swing"]:
+        if not eff["flexible"] or reduction != "none":
+            what = f"[{moving[0]}]" if moving else "effects.payload_swing = true"
+            why = ("effects.flexible = false" if not eff["flexible"] else
+                   "model.reduction = 'modal'")
+            raise SceneError(f"{what} with {why}: the rigid limit and the modal tables have a "
+                             "fixed luffing angle and a fixed payload (allowed: luffing, "
+                             "slewing or a swinging payload on flexible booms with "
+                             "model.reduction = 'none')")
     for name, plugin in plugins.items():
         tb = table_of(raw, name, "")
         if tb and not sc["effects"].get(name, False):
@@ -384,10 +622,7 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
                              f"{name} effect (allowed: effects.{name} = true, or leave it out)")
         if sc["effects"].get(name, False):
             sc[name] = plugin.validate(tb, sc)
-    mo = raw.get("model", {})
-    check_keys(mo, {"reduction", "n_modes"}, "model")
-    sc["model"] = {"reduction": choice(mo, "reduction", "model", ("none", "modal"), "none"),
-                   "n_modes": number(mo, "n_modes", "model", 3, lo=1, hi=4, integer=True)}
+    sc["model"] = {"reduction": reduction, "n_modes": MODEL.read(mo, "n_modes", "model")}
     if sc["model"]["reduction"] == "modal" and sc["contact"]["moment_model"] != "rigid":
         raise SceneError(f"model.reduction = 'modal' with contact.moment_model = "
                          f"{sc['contact']['moment_model']!r}: the modal tables are built with the "
@@ -405,45 +640,85 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
                              "model.reduction = 'none')")
     if sc["model"]["reduction"] == "modal":
         from sim_core.systems.telescopic.modal import allowed_ranges
-        (p_lo, p_hi), (a_lo, a_hi), _ = allowed_ranges(n_booms=sc["booms"]["count"])
+        (p_lo, p_hi), (a_lo, a_hi), (L_lo, L_hi) = allowed_ranges(n_booms=sc["booms"]["count"])
         if not p_lo <= sc["payload"]["mass"] <= p_hi:
             raise SceneError(f"payload.mass = {sc['payload']['mass']!r}: out of range, allowed "
                              f"[{p_lo:g}, {p_hi:g}] kg (the modal tables' payloads; "
                              "model.reduction = 'none' takes any payload)")
         if not a_lo <= sc["booms"]["luffing_angle_deg"] <= a_hi:
             raise SceneError(f"booms.luffing_angle_deg = {sc['booms']['luffing_angle_deg']!r}: "
-                             f"out of range, allowed [{a_lo:g}, {a_hi:g}] (the modal tables' "
+                             f"out of range, allowed [{a_lo:g}, {a_hi:g}] deg (the modal tables' "
                              "angles; model.reduction = 'none' takes 0..85)")
     if sc["model"]["reduction"] == "modal" and sc["effects"]["friction"]:
         raise SceneError("model.reduction = 'modal' with effects.friction = true: the modal tables "
                          "are frictionless; set effects.friction = false")
+    if sc["model"]["reduction"] == "modal":
+        _check_modal(sc, ls_lo, ls_hi, L_lo, L_hi)
     return sc
 
 
-def _check_actuator(d: dict, table: str, default: str) -> dict:
+# the parameters the modal tables are built for (sim_core.systems.telescopic.modal.
+# check_params) and the scene keys that set them
+_MODAL_KEYS = (("boom_length", "booms.length"), ("L_h", "booms.L_h"), ("E", "booms.E"),
+               ("rho", "booms.rho"), ("rope_EA", "ropes.EA"), ("gravity", "gravity.g"),
+               ("filter_h", "filtering.h"),
+               ("torsion", "effects.torsion"), ("rope_elasticity", "effects.rope_elasticity"),
+               ("flexible", "effects.flexible"))
+
+
+def _check_modal(sc: dict, ls_lo: float, ls_hi: float, L_lo: float, L_hi: float) -> None:
+    """What the modal ROM (sim_core.systems.telescopic.modal.simulate_modal) needs beyond the
+    tables' payloads and angles: the crane the tables were built from, the paper's cubic
+    schedule from t = 0 within the tables' stage lengths, and no effect the tables lack."""
+    from sim_core.systems.telescopic.modal import table_params
+    d = sc["drive"]
+    if d["profile"] != "cubic" or "t_start" in d:
+        raise SceneError(f"model.reduction = 'modal' with drive.profile = {d['profile']!r}"
+                         + (f" and drive.t_start = {d['t_start']:g} s" if "t_start" in d
+                            else "") + ": the modal ROM runs the cubic schedule from t = 0 "
+                         "(allowed: profile 'cubic' without t_start; other drives: "
+                         "model.reduction = 'none')")
+    if not L_lo - 1e-9 <= ls_lo <= ls_hi <= L_hi + 1e-9:
+        raise SceneError(f"drive: the stroke history moves L_s between {ls_lo:g} and {ls_hi:g} m, "
+                         f"outside the modal tables' stage lengths [{L_lo:g}, {L_hi:g}] m "
+                         "(allowed: booms.stroke0 and drive.v_max * drive.t_hold_end within "
+                         "them; other strokes: model.reduction = 'none')")
+    for name in ("mass_centre_offset", *effect_plugins()):
+        if sc["effects"].get(name):
+            raise SceneError(f"model.reduction = 'modal' with effects.{name} = true: the modal "
+                             "tables are built without it (allowed: false; with it: "
+                             "model.reduction = 'none')")
+    p, ref = params_from_scene(sc), table_params(sc["booms"]["count"])
+    for attr, key in _MODAL_KEYS:
+        if getattr(p, attr) != getattr(ref, attr):
+            off = {"gravity": "gravity", "filter_h": "filtering"}.get(attr)
+            shown = (f"effects.{off} = false" if off and not sc["effects"][off] else
+                     f"{key} = {getattr(p, attr)!r}")
+            raise SceneError(f"{shown}: the modal tables are built for {key} = "
+                             f"{getattr(ref, attr)!r} (other values: model.reduction = 'none')")
+
+
+def _check_actuator(d: dict, table: str) -> dict:
     """The drive profile of an actuator table (sim_core.systems.telescopic.actuators): its kind
     and the kind's keys, positions in the table's unit (m or deg), rates per s.  The telescopic
     [drive] keeps its cubic keys (direction, v_max, t_ramp, t_hold_end) beside these."""
-    out = {"profile": choice(d, "profile", table, ("hold", "cubic", "trapezoid", "table"),
-                             default)}
-    if table == "drive" and out["profile"] == "hold":
-        raise SceneError("drive.profile = 'hold': the telescopic stages hold with a table of "
-                         "one length (allowed: 'cubic', 'trapezoid', 'table')")
+    T = ACTUATOR_TABLES[table]
+    out = {"profile": T.read(d, "profile", table)}
     kind = out["profile"]
-    lo_travel = 0.0 if table == "drive" else None        # [drive]: a length, with direction
+    drive = table == "drive"
     if kind in ("cubic", "trapezoid") and "t_start" in d:
-        out["t_start"] = number(d, "t_start", table, lo=0.0)
-    if kind == "cubic" and table != "drive":
-        out["travel"] = number(d, "travel", table)
-        out["t_ramp"] = number(d, "t_ramp", table, 4.0, lo=0.0, lo_open=True)
-        out["t_hold_end"] = number(d, "t_hold_end", table, lo=out["t_ramp"])
+        out["t_start"] = T.read(d, "t_start", table)
+    if kind == "cubic" and not drive:
+        out["travel"] = T.read(d, "travel", table)
+        out["t_ramp"] = T.read(d, "t_ramp", table)
+        out["t_hold_end"] = T.read(d, "t_hold_end", table, lo=out["t_ramp"])
     if kind == "trapezoid":
-        out["travel"] = number(d, "travel", table, lo=lo_travel, lo_open=True)
-        if table != "drive":
-            out["v_max"] = number(d, "v_max", table, lo=0.0, lo_open=True)
-        out["a_max"] = number(d, "a_max", table, lo=0.0, lo_open=True)
+        out["travel"] = T.read(d, "travel", table)
+        if not drive:
+            out["v_max"] = T.read(d, "v_max", table)
+        out["a_max"] = T.read(d, "a_max", table)
         if "j_max" in d:
-            out["j_max"] = number(d, "j_max", table, lo=0.0, lo_open=True)
+            out["j_max"] = T.read(d, "j_max", table)
     if kind in ("cubic", "trapezoid") and out.get("travel", 1.0) == 0.0:
         raise SceneError(f"{table}.travel = 0: allowed a nonzero travel (or profile = 'hold')")
     if kind == "table":
@@ -451,19 +726,15 @@ def _check_actuator(d: dict, table: str, default: str) -> dict:
             raise SceneError(f"{table}: a table profile needs one of {table}.table (rows of "
                              f"[time s, position]) or {table}.table_file (a CSV file)")
         if "table" in d:
-            rows = d["table"]
-            if not (isinstance(rows, list) and all(isinstance(r, list) and len(r) == 2
-                                                   for r in rows)):
-                raise SceneError(f"{table}.table = {rows!r}: must be rows [time s, position]")
-            out["table"] = [[float(x) for x in r] for r in rows]
+            out["table"] = T.read(d, "table", table)
         else:
-            if not isinstance(d["table_file"], str):
-                raise SceneError(f"{table}.table_file = {d['table_file']!r}: must be a path")
-            out["table_file"] = d["table_file"]
+            out["table_file"] = T.read(d, "table_file", table)
     for k in ("max_rate", "max_accel"):
         if k in d:
-            out[k] = number(d, k, table, lo=0.0, lo_open=True)
-    own = set(_PROFILE_KEYS) | ({"v_max", "t_ramp", "t_hold_end"} if table != "drive" else set())
+            out[k] = T.read(d, k, table)
+    own = T.all_keys()
+    if drive:
+        own -= {"direction", "v_max", "t_ramp", "t_hold_end", "mechanism"}
     unused = sorted(set(d) & own - set(out) - {"profile"})
     if unused:
         raise SceneError(f"{table}.{unused[0]}: not a key of the {kind!r} profile")
@@ -507,6 +778,8 @@ def _check_slew_history(sc: dict, luff, slew, t_end: float) -> None:
                              "more than 15 deg; slew less or luff higher)")
 
 
+
+
 def _check_booms(tables: list, E0: float, rho0: float) -> list[dict]:
     """The [[boom]] tables, outermost first: length, material and section (its constants
     computed here, so a bad section fails before the run and the resolved scene records them)."""
@@ -515,14 +788,18 @@ def _check_booms(tables: list, E0: float, rho0: float) -> list[dict]:
     out = []
     for i, t in enumerate(tables):
         w = f"boom[{i}]"
-        check_keys(t, {"length", "E", "nu", "G", "rho", "section"}, w)
+        BOOM.check_keys(t, w)
         if "nu" in t and "G" in t:
             raise SceneError(f"{w}.nu and {w}.G: give one of the two (G = E / (2 (1 + nu)))")
-        E = number(t, "E", w, E0, lo=1e8, hi=1e15)
-        nu = number(t, "nu", w, 0.3, lo=-1.0, hi=0.5, lo_open=True, hi_open=True)
-        out.append({"length": number(t, "length", w, lo=0.0, lo_open=True), "E": E,
-                    "G": number(t, "G", w, E / (2.0 * (1.0 + nu)), lo=0.0, lo_open=True),
-                    "rho": number(t, "rho", w, rho0, lo=10.0, hi=1e5),
+        E = BOOM.read(t, "E", w, default=E0)
+        nu = BOOM.read(t, "nu", w)
+        G = BOOM.read(t, "G", w, default=E / (2.0 * (1.0 + nu)))
+        Gf = BOOM["G"]
+        if "G" not in t and not Gf.lo <= G <= Gf.hi:
+            raise SceneError(f"{w}.nu = {nu!r}: gives G = E / (2 (1 + nu)) = {G:g} Pa, outside "
+                             f"the allowed {Gf.range_text()} (give G, or another nu)")
+        out.append({"length": BOOM.read(t, "length", w), "E": E, "G": G,
+                    "rho": BOOM.read(t, "rho", w, default=rho0),
                     "section": _check_section(table_of(t, "section", w), i)})
         c = out[-1]["section"]["constants"]
         if "mass_per_length" not in c:
@@ -537,46 +814,35 @@ def _check_section(t: dict, i: int) -> dict:
     if not t:
         raise SceneError(f"{w}: missing (required: a table with shape = 'u', 'box', 'polygon' "
                          "or 'properties')")
-    shape = choice(t, "shape", w, ("u", "box", "polygon", "properties"))
-    given = {k: number(t, k, w, lo=0.0, lo_open=True) for k in ("A", "I_t", "I_b", "J",
-                                                               "mass_per_length") if k in t}
-    for k in ("y_c", "z_c"):
-        if k in t:
-            given[k] = number(t, k, w, lo=-10.0, hi=10.0)
+    shape = SECTION.read(t, "shape", w)
+    given = {k: SECTION.read(t, k, w) for k in _GIVEN if k in t}
     if shape == "properties":
         for k in ("A", "I_t", "I_b", "J", "mass_per_length"):
-            number(t, k, w, lo=0.0, lo_open=True)          # required
-        check_keys(t, {"shape", *_GIVEN}, w)
+            SECTION.read(t, k, w, required=True)
+        SECTION.check_keys(t, w, tag=shape)
         given.setdefault("y_c", 0.0)
         given.setdefault("z_c", 0.0)
         spec = {"shape": "properties", **given}
     else:
+        SECTION.check_keys(t, w, tag=shape)
         geo = {k: v for k, v in t.items() if k not in _GIVEN}
-        if shape == "u":
-            check_keys(geo, {"shape", "top_arc_centre_y", "top_arc_centre_z", "top_arc_radius",
-                             "bottom_arc_radius", "wall"}, w)
-            for k in ("top_arc_centre_y", "top_arc_centre_z"):
-                number(t, k, w, lo=0.0)
-            number(t, "top_arc_radius", w, lo=0.0, lo_open=True)
-            if "bottom_arc_radius" in t:
-                number(t, "bottom_arc_radius", w, lo=0.0, lo_open=True)
-        elif shape == "box":
-            check_keys(geo, {"shape", "width", "height", "wall", "corner_radius"}, w)
-            for k in ("width", "height"):
-                number(t, k, w, lo=0.0, lo_open=True)
-            if "corner_radius" in t:
-                number(t, "corner_radius", w, lo=0.0)
-        else:
-            check_keys(geo, {"shape", "n_sides", "width_across_flats", "circumradius",
-                             "rotation_deg", "contour", "wall"}, w)
-            if "contour" not in t:
-                number(t, "n_sides", w, lo=3, hi=24, integer=True)
-                for k in ("width_across_flats", "circumradius"):
-                    if k in t:
-                        number(t, k, w, lo=0.0, lo_open=True)
-                if "rotation_deg" in t:
-                    number(t, "rotation_deg", w, lo=-180.0, hi=180.0)
-        number(t, "wall", w, lo=0.0, lo_open=True)
+        # the ranges of the shape's keys (a table keeps its values as given: the geometry's
+        # own checks, sim_core.physics.cross_sections, read them)
+        keys = [f.key for f in SECTION.fields if f.when == (shape,)]
+        if shape == "polygon":
+            keys = (["contour"] if "contour" in t else
+                    [k for k in keys if k != "contour"])
+        for k in keys:
+            if k in t or SECTION[k].default is REQUIRED:
+                SECTION.read(t, k, w)
+        wall = SECTION.read(t, "wall", w)
+        perimeter = _outer_perimeter(shape, t)
+        if perimeter is not None and perimeter > MAX_SLENDERNESS * wall:
+            raise SceneError(f"{w}.wall = {wall!r} m: the outer contour is about "
+                             f"{perimeter:.4g} m long, {perimeter / wall:.4g} walls (allowed: at "
+                             f"most {MAX_SLENDERNESS:g}, a wall of at least "
+                             f"{perimeter / MAX_SLENDERNESS:.3g} m; thinner walls buckle locally, "
+                             "and the section analysis meshes ~4 triangles per wall length)")
         spec = dict(geo)
     cs = cross_section_of({**spec, "_where": w})
     constants = {"A": cs.A, "I_t": cs.I_t, "I_b": cs.I_b, "J": cs.J, "y_c": cs.y_c,
@@ -594,6 +860,36 @@ def _check_section(t: dict, i: int) -> dict:
             "method": cs.method}
 
 
+#: the longest outer contour of a boom section in walls (contour length / wall thickness): a
+#: width-to-wall ratio of about 250, beyond thin-walled crane booms (b/t up to ~150); the
+#: section analysis (sim_core.physics.cross_sections) meshes about 4 triangles per wall length
+#: of contour, ~10 s per section at this limit on 2 cores
+MAX_SLENDERNESS = 1000.0
+
+
+def _outer_perimeter(shape: str, t: dict) -> float | None:
+    """About the length of a section's outer contour, m (None where the keys do not give it:
+    the geometry's own checks refuse the section)."""
+    if shape == "box":
+        return 2.0 * (t["width"] + t["height"])
+    if shape == "u":
+        ya, za, r = t["top_arc_centre_y"], t["top_arc_centre_z"], t["top_arc_radius"]
+        return math.pi * (ya + r) + 2.0 * za + 2.0 * math.pi * r + 2.0 * ya
+    if "contour" in t:
+        pts = t["contour"]
+        return math.fsum(math.dist(pts[i - 1], pts[i]) for i in range(len(pts)))
+    n = t.get("n_sides")
+    if not isinstance(n, (int, float)) or n < 3:
+        return None
+    if "width_across_flats" in t:
+        apothem = 0.5 * t["width_across_flats"]
+    elif "circumradius" in t:
+        apothem = t["circumradius"] * math.cos(math.pi / n)
+    else:
+        return None
+    return 2.0 * n * apothem * math.tan(math.pi / n)
+
+
 def cross_section_of(spec: dict):
     """The CrossSection of a section table (sim_core.physics.cross_sections; cached there)."""
     from sim_core.physics.cross_sections import cross_section
@@ -603,11 +899,9 @@ def cross_section_of(spec: dict):
 
 def _check_luffing(t: dict, booms: dict, L_h: float, L1: float) -> dict:
     """The [luffing] table: the mounting points D1, D2, D3 (docs/model.md#input-luffing)."""
-    check_keys(t, {"pivot", "pivot_on_boom", "base", "head_on_boom"}, "luffing")
-    out = {"pivot": vector(t, "pivot", "luffing", [-0.556, 0.350], n=2),
-           "pivot_on_boom": vector(t, "pivot_on_boom", "luffing", [-0.956, 0.556], n=2),
-           "base": vector(t, "base", "luffing", [0.100, 0.050], n=2),
-           "head_on_boom": vector(t, "head_on_boom", "luffing", [L_h, -0.556], n=2)}
+    LUFFING.check_keys(t, "luffing")
+    out = {k: LUFFING.read(t, k, "luffing") for k in ("pivot", "pivot_on_boom", "base")}
+    out["head_on_boom"] = LUFFING.read(t, "head_on_boom", "luffing", default=[L_h, -0.556])
     s3 = out["head_on_boom"][0]
     if "L_h" in booms and "head_on_boom" in t and s3 != L_h:
         raise SceneError(f"luffing.head_on_boom[0] = {s3:g} m and booms.L_h = {L_h:g} m: both "
@@ -641,14 +935,11 @@ def _check_overlaps(tables: list, sc: dict, ls_min: float, ls_max: float) -> lis
     for k in range(n - 1):
         t = tables[k] if tables else {}
         w = f"overlap[{k}]"
-        check_keys(t, {"slider_width", "inner_slider_distance", "outer_slider_distance",
-                       "radial_gap", "bears_on"}, w)
-        o = {"slider_width": number(t, "slider_width", w, c["slider_width"], lo=0.0,
-                                    lo_open=True),
-             "inner_slider_distance": number(t, "inner_slider_distance", w, 0.0, lo=0.0),
-             "outer_slider_distance": number(t, "outer_slider_distance", w, 0.0, lo=0.0),
-             "radial_gap": number(t, "radial_gap", w, c["radial_gap"], lo=0.0, hi=0.05,
-                                  lo_open=True),
+        OVERLAP.check_keys(t, w)
+        o = {"slider_width": OVERLAP.read(t, "slider_width", w, default=c["slider_width"]),
+             "inner_slider_distance": OVERLAP.read(t, "inner_slider_distance", w),
+             "outer_slider_distance": OVERLAP.read(t, "outer_slider_distance", w),
+             "radial_gap": OVERLAP.read(t, "radial_gap", w, default=c["radial_gap"]),
              "bears_on": None}
         Lo, Li = lengths[k], lengths[k + 1]
         sw, d_in, d_out = o["slider_width"], o["inner_slider_distance"], o["outer_slider_distance"]
@@ -665,10 +956,7 @@ def _check_overlaps(tables: list, sc: dict, ls_min: float, ls_max: float) -> lis
                              f"than half the slider width, {0.5 * sw:g} m; lengthen boom {k + 2} "
                              f"or set {w}.outer_slider_distance)")
         if "bears_on" in t:
-            v = t["bears_on"]
-            if not (isinstance(v, list) and v and all(isinstance(x, str) for x in v)):
-                raise SceneError(f"{w}.bears_on = {v!r}: must be a non-empty list of patch names")
-            o["bears_on"] = list(v)
+            o["bears_on"] = OVERLAP.read(t, "bears_on", w)
         if booms:
             _check_fit(booms[k], booms[k + 1], o, k, sc["effects"]["contact_distribution"])
         elif o["bears_on"] is not None:
