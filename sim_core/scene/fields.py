@@ -393,6 +393,15 @@ class Table:
     def read(self, table: dict, key: str, where: str, **kw):
         return self._index[key].read(table, where, **kw)
 
+    def resolve(self, parent: dict, name: str, keys=None) -> dict:
+        """The sub-table ``name`` of ``parent`` checked and read: its keys checked, then
+        ``keys`` (default: every field without a ``when`` tag, in declared order) read with
+        their defaults and ranges."""
+        table = table_of(parent, name, "")
+        self.check_keys(table, name)
+        keys = [f.key for f in self.fields if not f.when] if keys is None else keys
+        return {k: self.read(table, k, name) for k in keys}
+
     def array(self, parent: dict) -> list[dict]:
         """The array of tables this table declares (``[[name]]``) from its parent, its count
         within ``items``."""

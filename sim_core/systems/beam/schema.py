@@ -176,12 +176,8 @@ def validate(raw: dict, source: str = "<scene>") -> dict:
     e = table_of(raw, "effects", "")
     EFFECTS.check_keys(e, "effects")
     sc["effects"] = {k: EFFECTS.read(e, k, "effects") for k in ("gravity", "torsion", "filtering")}
-    f = table_of(raw, "filtering", "")
-    FILTERING.check_keys(f, "filtering")
-    sc["filtering"] = {"h": FILTERING.read(f, "h", "filtering")}
-    g = table_of(raw, "gravity", "")
-    GRAVITY.check_keys(g, "gravity")
-    sc["gravity"] = {"g": GRAVITY.read(g, "g", "gravity")}
+    sc["filtering"] = FILTERING.resolve(raw, "filtering", ("h",))
+    sc["gravity"] = GRAVITY.resolve(raw, "gravity", ("g",))
 
     beams = raw.get("beams")
     if not isinstance(beams, list) or not beams:

@@ -140,12 +140,8 @@ def validate_folding(raw: dict, source: str) -> dict[str, Any]:
     EFFECTS.check_keys(e, "effects")
     sc["effects"] = {"gravity": EFFECTS.read(e, "gravity", "effects"),
                      "filtering": EFFECTS.read(e, "filtering", "effects")}
-    f = table_of(raw, "filtering", "")
-    FILTERING.check_keys(f, "filtering")
-    sc["filtering"] = {"h": FILTERING.read(f, "h", "filtering")}
-    g = table_of(raw, "gravity", "")
-    GRAVITY.check_keys(g, "gravity")
-    sc["gravity"] = {"g": GRAVITY.read(g, "g", "gravity")}
+    sc["filtering"] = FILTERING.resolve(raw, "filtering", ("h",))
+    sc["gravity"] = GRAVITY.resolve(raw, "gravity", ("g",))
     _check_geometry(sc)
     return sc
 

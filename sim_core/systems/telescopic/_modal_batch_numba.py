@@ -67,6 +67,31 @@ def _first_hit(L, v, a, stop):
     return best
 
 
+def _piston_segment(Lk, vk, ak, t_left, vmax, Lmin, Lmax):
+    """The next piece of constant piston acceleration within t_left (s) from (L_s, v): the
+    commanded acceleration ak cut to 0 at the rate limit |v| = vmax and against an end stop
+    it rests on; its duration tau ends at t_left, at the rate limit (after t_v) or at an end
+    stop (after t_s).  Returns (acceleration, tau, t_v, t_s, saturated, stopped)."""
+    ae = ak
+    sat = False
+    stop = False
+    if (vk >= vmax - 1e-12 and ak > 0) or (vk <= -vmax + 1e-12 and ak < 0):
+        ae = 0.0
+        sat = True
+    if ((Lk >= Lmax - 1e-12 and vk >= 0) and ae > 0) or \
+            ((Lk <= Lmin + 1e-12 and vk <= 0) and ae < 0):
+        ae = 0.0
+        stop = True
+    t_v = np.inf
+    if ae > 0:
+        t_v = (vmax - vk) / ae
+    elif ae < 0:
+        t_v = (-vmax - vk) / ae
+    t_s = min(_first_hit(Lk, vk, ae, Lmax), _first_hit(Lk, vk, ae, Lmin))
+    tau = min(min(t_left, t_v), t_s)
+    return ae, tau, t_v, t_s, sat, stop
+
+
 def _at_rest_unforced(fin, g, kk, b1, qj, qdj):
     """Whether a mode is at rest (q = q' = 0) without forcing (Gamma = K2 = b1 = 0, finite
     stroke inputs ``fin``) over a step: it then stays at rest exactly (the out-of-plane
@@ -135,21 +160,10 @@ def _step_one(k, L, v, q, qd, a, dyn, grid, dt, vmax, Lmin, Lmax, sat, stop, acc
     for _ in range(8):
         if t_left <= 1e-12:
             break
-        ae = ak
-        if (vk >= vmax - 1e-12 and ak > 0) or (vk <= -vmax + 1e-12 and ak < 0):
-            ae = 0.0
-            s_sat = True
-        if ((Lk >= Lmax - 1e-12 and vk >= 0) and ae > 0) or \
-                ((Lk <= Lmin + 1e-12 and vk <= 0) and ae < 0):
-            ae = 0.0
-            s_stop = True
-        t_v = np.inf
-        if ae > 0:
-            t_v = (vmax - vk) / ae
-        elif ae < 0:
-            t_v = (-vmax - vk) / ae
-        t_s = min(_first_hit(Lk, vk, ae, Lmax), _first_hit(Lk, vk, ae, Lmin))
-        tau = min(min(t_left, t_v), t_s)
+        ae, tau, t_v, t_s, sat_k, stop_k = _piston_segment(Lk, vk, ak, t_left, vmax, Lmin,
+                                                           Lmax)
+        s_sat = s_sat or sat_k
+        s_stop = s_stop or stop_k
         if tau > 0:
             _advance(dyn, grid, k, Lk, vk, ae, tau, q, qd)
         L1 = Lk + vk * tau + 0.5 * ae * tau * tau
@@ -416,21 +430,10 @@ def _step_friction_one(k, xc, vc, e, ed, stuck, sdir, q, qd, a, dyn, ntab, grid,
     for _ in range(8):
         if t_left <= 1e-12:
             break
-        ae = ak
-        if (vk >= vmax - 1e-12 and ak > 0) or (vk <= -vmax + 1e-12 and ak < 0):
-            ae = 0.0
-            s_sat = True
-        if ((Lk >= Lmax - 1e-12 and vk >= 0) and ae > 0) or \
-                ((Lk <= Lmin + 1e-12 and vk <= 0) and ae < 0):
-            ae = 0.0
-            s_stop = True
-        t_v = np.inf
-        if ae > 0:
-            t_v = (vmax - vk) / ae
-        elif ae < 0:
-            t_v = (-vmax - vk) / ae
-        t_s = min(_first_hit(Lk, vk, ae, Lmax), _first_hit(Lk, vk, ae, Lmin))
-        tau = min(min(t_left, t_v), t_s)
+        ae, tau, t_v, t_s, sat_k, stop_k = _piston_segment(Lk, vk, ak, t_left, vmax, Lmin,
+                                                           Lmax)
+        s_sat = s_sat or sat_k
+        s_stop = s_stop or stop_k
         # the stage within this commanded segment, piece by piece
         t_seg = 0.0
         for _p in range(64):
@@ -769,6 +772,7 @@ if AVAILABLE:
     _interval = _jit(_interval)
     _jacobi_eigh = _jit(_jacobi_eigh)
     _first_hit = _jit(_first_hit)
+    _piston_segment = _jit(_piston_segment)
     _at_rest_unforced = _jit(_at_rest_unforced)
     _advance = _jit(_advance)
     _step_one = _jit(_step_one)

@@ -497,12 +497,8 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
                              f"({what}): a boom would leave its neighbour")
         actuators.check_limits("drive", sc["drive"], prof, sc["solver"]["t_end"])
         end = ls_hi if ls_hi != sc["booms"]["stroke0"] else ls_lo
-    pl = table_of(raw, "payload", "")
-    PAYLOAD.check_keys(pl, "payload")
-    sc["payload"] = {"mass": PAYLOAD.read(pl, "mass", "payload")}
-    r = table_of(raw, "ropes", "")
-    ROPES.check_keys(r, "ropes")
-    sc["ropes"] = {"EA": ROPES.read(r, "EA", "ropes")}
+    sc["payload"] = PAYLOAD.resolve(raw, "payload", ("mass",))
+    sc["ropes"] = ROPES.resolve(raw, "ropes", ("EA",))
     e = table_of(raw, "effects", "")
     EFFECTS.check_keys(e, "effects")
     three = sc["booms"]["count"] == 3 or bool(boom_tables)
@@ -559,12 +555,8 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
             raise SceneError(f"contact.slider_width = {sc['contact']['slider_width']:g} m does not "
                              f"fit the shortest overlap of adjacent booms, booms.length - max L_s "
                              f"= {overlap:g} m (allowed: 0 < slider_width < {overlap:g} m)")
-    f = table_of(raw, "filtering", "")
-    FILTERING.check_keys(f, "filtering")
-    sc["filtering"] = {"h": FILTERING.read(f, "h", "filtering")}
-    g = table_of(raw, "gravity", "")
-    GRAVITY.check_keys(g, "gravity")
-    sc["gravity"] = {"g": GRAVITY.read(g, "g", "gravity")}
+    sc["filtering"] = FILTERING.resolve(raw, "filtering", ("h",))
+    sc["gravity"] = GRAVITY.resolve(raw, "gravity", ("g",))
     # the other actuators (sim_core.systems.telescopic.actuators) and the hoisted payload
     t_end = sc["solver"]["t_end"]
     theta0 = sc["booms"]["luffing_angle_deg"]
