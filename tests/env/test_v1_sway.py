@@ -168,21 +168,22 @@ def test_sway_under_the_cubic_extraction_matches_the_full_model():
 
 @pytest.mark.slow
 def test_full_physics_fidelity_of_the_v1_env_follows_the_rom():
-    """fidelity="train" steps the full model with the swinging payload (boom_env.full_physics,
-    the scene's 500 kg hook added to the payload) along the env's stroke kinematics: over the
-    first 5 s of the cubic extraction its sway follows the ROM's within the motion-phase
-    tolerance of the cubic comparison above (6 % of the peak) plus the hook's 2 % of the
-    hanging mass.  The tip deflection is a few mm there, of which the bending vibration is
-    about a fifth; the ROM's bending vibration is within a factor 2 of the full model's (v0's
-    validation, tests/env/test_modal.py), the training fidelity's rtol is 1e-3: 25 % of the
-    peak deflection."""
+    """fidelity="paper" steps the full model with the swinging payload (boom_env.full_physics,
+    the scene's 500 kg hook added to the payload) along the env's stroke kinematics, on the
+    mesh the modal tables were built from (3 nodes per spline element; the converged 9-node
+    mesh of fidelity="train" differs from it by millimetres, benchmarks/results/
+    training_fidelity.md): over the first 5 s of the cubic extraction its sway follows the
+    ROM's within the motion-phase tolerance of the cubic comparison above (6 % of the peak)
+    plus the hook's 2 % of the hanging mass.  The tip deflection is a few mm there, of which the
+    bending vibration is about a fifth; the ROM's bending vibration is within a factor 2 of the
+    full model's (v0's validation, tests/env/test_modal.py): 25 % of the peak deflection."""
     import gymnasium as gym
 
     import boom_env  # noqa: F401
     from agents.schedules import cubic
     acts = cubic().actions(0.05, 0.25, 100)
     out = {}
-    for fid in ("rl", "train"):
+    for fid in ("rl", "paper"):
         env = gym.make("boom_env/TelescopicExtraction-v1", fidelity=fid, friction=False)
         env.reset(seed=0)
         rows = []
@@ -191,8 +192,8 @@ def test_full_physics_fidelity_of_the_v1_env_follows_the_rom():
             assert not info["diverged"], info["reason"]
             rows.append(obs[[5, 6, 9]])
         out[fid] = np.array(rows)
-    peak = np.max(np.abs(out["train"][:, 2]))
+    peak = np.max(np.abs(out["paper"][:, 2]))
     assert peak > 0.02
-    assert np.max(np.abs(out["rl"][:, 2] - out["train"][:, 2])) <= 0.08 * peak
-    d_peak = np.max(np.abs(out["train"][:, :2]))
-    assert np.max(np.abs(out["rl"][:, :2] - out["train"][:, :2])) <= 0.25 * d_peak
+    assert np.max(np.abs(out["rl"][:, 2] - out["paper"][:, 2])) <= 0.08 * peak
+    d_peak = np.max(np.abs(out["paper"][:, :2]))
+    assert np.max(np.abs(out["rl"][:, :2] - out["paper"][:, :2])) <= 0.25 * d_peak
