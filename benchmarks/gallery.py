@@ -15,8 +15,9 @@ the whole manoeuvre) and writes
 * ``docs/gallery/<scene>/report.html``: :func:`sim_core.report.write_report` with the
   animation embedded and plotly.js loaded from ``docs/gallery/plotly.min.js``, one copy for
   all reports; every output but the replay geometry and the integrator state (``LEFT_OUT``);
-* ``docs/gallery/<scene>/meta.json``: what the page says of the run (simulated time, wall
-  time, method, animation or the reason for none, the commit it was built from);
+* ``docs/gallery/<scene>/meta.json``: the run's record (simulated time, wall time, method,
+  animation or the reason for none, and the commit it was built from, which the page leaves
+  out);
 
 and then rewrites ``docs/gallery.md`` from the shipped scenes and every ``meta.json`` present,
 so a run of some scenes keeps the others' entries and a scene never built says which command
@@ -167,8 +168,7 @@ def page() -> str:
         run = f"{meta['t_end_s']:g} s simulated ({meta['method']}, {meta['n_dof']} coordinates)"
         if meta.get("error"):
             run += f"; the run stopped early: {meta['error']}"
-        lines += [f"[Report](gallery/{meta['report']}) · {run} · built {meta['built']} from "
-                  f"commit {meta['commit']}.", ""]
+        lines += [f"[Report](gallery/{meta['report']}) · {run}.", ""]
         if meta.get("animation"):
             lines += [f"![{name}](gallery/{meta['animation']})", "",
                       f"*{html.escape(meta['animation_note'])}.*", ""]
