@@ -205,6 +205,7 @@ from gymnasium import spaces
 from sim_core import Command, Simulation, SimulationError, load_scene
 from sim_core.rom import TABLE_BOOMS, allowed_ranges, luffing_geometry, tables_for
 
+from ._checks import number, range_pair
 from .full_physics import FullPhysicsPlant
 
 BOOM_LENGTH = 10.0          # m, docs/model.md#input-sections
@@ -338,7 +339,7 @@ class TelescopicBoomEnv(gym.Env):
         for name, v in (("stroke_limits", stroke_limits), ("payload_range", payload_range),
                         ("angle_range", angle_range)):
             if v is not None:
-                _pair(name, v)
+                range_pair(name, v, -math.inf, math.inf)
         if isinstance(paper_n_nodes, bool) or not isinstance(paper_n_nodes, (int, np.integer)) \
                 or not 3 <= paper_n_nodes <= 33:
             raise ValueError(f"paper_n_nodes = {paper_n_nodes!r}: allowed integers 3..33 "
@@ -678,27 +679,13 @@ class TelescopicBoomEnv(gym.Env):
 
 
 def _real(name, value, lo=-math.inf, strict=False):
-    """``value`` as a float: a real number (bool excluded; TypeError otherwise), finite and
-    >= lo (> lo with ``strict``; ValueError otherwise), the message naming the argument."""
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise TypeError(f"{name} = {value!r}: must be a real number")
-    v = float(value)
-    if not math.isfinite(v) or v < lo or (strict and v == lo):
+    """``value`` as a float (a real, finite number: :func:`boom_env._checks.number`), >= lo
+    (> lo with ``strict``; ValueError otherwise), the message naming the argument."""
+    v = number(name, value)
+    if v < lo or (strict and v == lo):
         bound = f"> {lo:g}" if strict else f">= {lo:g}"
         raise ValueError(f"{name} = {value!r}: must be finite and {bound}")
     return v
-
-
-def _pair(name, value):
-    """A (lo, hi) pair of finite real numbers with lo <= hi, the message naming the argument."""
-    try:
-        lo, hi = value
-    except (TypeError, ValueError):
-        raise TypeError(f"{name} = {value!r}: must be a pair (lo, hi) of numbers") from None
-    lo, hi = _real(name, lo), _real(name, hi)
-    if lo > hi:
-        raise ValueError(f"{name} = {value!r}: lo must not exceed hi")
-    return lo, hi
 
 
 def _first_hit(L, v, a, stop):

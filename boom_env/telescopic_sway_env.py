@@ -177,6 +177,12 @@ from gymnasium import spaces
 from sim_core.vector_rom import ROPE_RANGE, SWAY_LIMIT, TABLE_BOOMS, VectorROM, allowed_ranges
 
 from . import _sway_kernel as kernel
+from ._checks import flag as _flag
+from ._checks import in_range as _in_range
+from ._checks import integer as _integer
+from ._checks import nonneg as _nonneg
+from ._checks import positive as _positive
+from ._checks import range_pair as _range_pair
 
 BOOM_LENGTH = 10.0                            # m, docs/model.md#input-sections
 DEFAULT_PAYLOAD = {3: 25000.0, 5: 10000.0}    # kg, as v0
@@ -194,63 +200,6 @@ RESET_OPTIONS = ("payload", "luffing_angle_deg", "rope_length", "stroke_start",
                  "stroke_target", "sway")
 FIDELITIES = ("rl", "paper", "train")
 HOIST_EA, HOOK_MASS = 2e8, 500.0             # N, kg: the crane scenes' hoist rope and hook
-
-
-# -- argument checks: TypeError for a wrong type, ValueError for a value out of range ----------
-def _number(name, v):
-    if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, float, np.integer,
-                                                             np.floating)):
-        raise TypeError(f"{name} = {v!r}: must be a real number")
-    v = float(v)
-    if not math.isfinite(v):
-        raise ValueError(f"{name} = {v!r}: must be finite")
-    return v
-
-
-def _positive(name, v, hi=math.inf):
-    v = _number(name, v)
-    if not 0 < v <= hi:
-        raise ValueError(f"{name} = {v!r}: allowed (0, {hi:g}]")
-    return v
-
-
-def _nonneg(name, v):
-    v = _number(name, v)
-    if v < 0:
-        raise ValueError(f"{name} = {v!r}: allowed [0, inf)")
-    return v
-
-
-def _in_range(name, v, lo, hi):
-    v = _number(name, v)
-    if not lo - 1e-9 <= v <= hi + 1e-9:
-        raise ValueError(f"{name} = {v!r}: allowed [{lo:g}, {hi:g}]")
-    return min(max(v, lo), hi)
-
-
-def _range_pair(name, v, lo, hi):
-    if v is None:
-        return None
-    if isinstance(v, (str, bytes)) or not hasattr(v, "__len__") or len(v) != 2:
-        raise TypeError(f"{name} = {v!r}: must be a pair (lo, hi) or None")
-    a, b = (_in_range(name, x, lo, hi) for x in v)
-    if a > b:
-        raise ValueError(f"{name} = {v!r}: lo > hi")
-    return (a, b)
-
-
-def _flag(name, v):
-    if not isinstance(v, (bool, np.bool_)):
-        raise TypeError(f"{name} = {v!r}: must be True or False")
-    return bool(v)
-
-
-def _integer(name, v, allowed):
-    if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)):
-        raise TypeError(f"{name} = {v!r}: must be an integer, allowed {allowed}")
-    if int(v) not in allowed:
-        raise ValueError(f"{name} = {v!r}: allowed {allowed}")
-    return int(v)
 
 
 class SwayTask:
