@@ -215,13 +215,7 @@ class TelescopicStepper:
             self.clock[0] = clock
         out["time"] = self.t
         out["actuators"] = self._actuators()
-        if names is None:
-            return out
-        missing = [k for k in names if k not in out]
-        if missing:
-            raise KeyError(f"outputs {missing}: not outputs of this scene (allowed: "
-                           f"{', '.join(sorted(out))})")
-        return {k: out[k] for k in names}
+        return _selected(out, names, "this scene")
 
     def _actuators(self) -> dict:
         return {k: tuple(float(x) for x in d.at(self.t)[:3]) for k, d in self.drives.items()}
@@ -367,14 +361,7 @@ class ModalStepper:
                "tip_deflection_rate": dv, "piston_stroke": rom.L - self.params.stroke0,
                "modal_coordinates": rom.q.copy(), "modal_rates": rom.qd.copy(),
                "actuators": {"telescopic": (float(rom.L), float(rom.v), float(a))}}
-        if names is None:
-            return out
-        names = tuple(names)
-        missing = [k for k in names if k not in out]
-        if missing:
-            raise KeyError(f"outputs {missing}: not outputs of the modal ROM (allowed: "
-                           f"{', '.join(sorted(out))})")
-        return {k: out[k] for k in names}
+        return _selected(out, names, "the modal ROM")
 
     def save_state(self) -> dict:
         rom = self.rom
@@ -388,3 +375,16 @@ class ModalStepper:
         rom.q = np.array(state["q"], dtype=float)
         rom.qd = np.array(state["qd"], dtype=float)
         self.command = state["command"]
+
+
+def _selected(out: dict, names, source: str) -> dict:
+    """``out`` (every output), or only ``names`` of it; a name it lacks raises KeyError naming
+    ``source`` and the outputs it has."""
+    if names is None:
+        return out
+    names = tuple(names)
+    missing = [k for k in names if k not in out]
+    if missing:
+        raise KeyError(f"outputs {missing}: not outputs of {source} (allowed: "
+                       f"{', '.join(sorted(out))})")
+    return {k: out[k] for k in names}
