@@ -1,11 +1,14 @@
-"""Side-by-side animation of the v1 env: the paper's cubic schedule against another stroke
-schedule (a trained policy's place), payload swinging on its rope.
+"""Side-by-side animation of the v1 env: the paper's cubic schedule against a trained policy
+or another stroke schedule, payload swinging on its rope.
 
     python benchmarks/env_video.py                       # docs/img/v1_cubic_vs_policy.gif
     python benchmarks/env_video.py --other zv_trapezoid --out /tmp/x.gif
 
 Both runs are ``boom_env/TelescopicExtraction-v1`` (25 t, 60 deg, 5 m rope, friction on), the
-schedules of :mod:`agents.schedules` turned into actions by their mean acceleration per step.
+schedules of :mod:`agents.schedules` turned into actions by their mean acceleration per step;
+``--other ppo_vector`` (the default) is the large-batch PPO of the baselines table, training
+seed 0, acting deterministically (its model from the run cache agents/runs/baselines that
+``python benchmarks/baselines.py`` fills).
 Every ``--every``-th frame of the env's ``rgb_array`` render (tip deflection x20, sway x5, as
 the titles say) is kept, the two frames put side by side and scaled by ``--scale``; the GIF is
 written atomically.  Each panel's caption names its schedule and the episode's return.
@@ -27,19 +30,37 @@ sys.path.insert(0, ROOT)
 OUT = os.path.join(ROOT, "docs", "img", "v1_cubic_vs_policy.gif")
 
 
-def run(schedule: str, every: int, seconds: float):
+def actor(name: str):
+    """act(obs (d,), k) -> normalised action of the schedule or trained baseline ``name``."""
+    from agents import baselines, schedules
+    if name in schedules.NAMES:
+        acts = np.concatenate([baselines.schedule_actions(name), [0.0]])
+        return lambda obs, k: float(acts[min(k, len(acts) - 1)])
+    if name not in baselines.TRAINED or name == "ppo_residual":
+        raise SystemExit(f"--other {name!r}: a schedule ({', '.join(schedules.NAMES)}) or "
+                         "a trained baseline (ppo_vector, sac, ppo_scratch)")
+    from pathlib import Path
+    cache = baselines.load_cache(Path(ROOT) / "agents" / "runs" / "baselines" / "rows" /
+                                 f"{name}.json")
+    rec = cache["seeds"].get("0")
+    if rec is None:
+        raise SystemExit(f"--other {name}: no trained seed 0 in agents/runs/baselines (run "
+                         f"python benchmarks/baselines.py --rows {name} --seeds 0)")
+    act = baselines.actor_for(name, 0, rec)
+    return lambda obs, k: float(np.asarray(act(obs[None], np.array([k]))).ravel()[0])
+
+
+def run(name: str, every: int, seconds: float):
     import gymnasium as gym
 
     import boom_env  # noqa: F401
-    from agents import schedules
+    act = actor(name)
     env = gym.make("boom_env/TelescopicExtraction-v1", render_mode="rgb_array")
-    env.reset(seed=0)
-    dt = env.unwrapped.dt
-    n = int(round(seconds / dt))
-    acts = schedules.by_name(schedule).actions(dt, env.unwrapped.core.a_max, n)
+    obs, _ = env.reset(seed=0)
+    n = int(round(seconds / env.unwrapped.dt))
     frames, ret = [env.render()], 0.0
-    for k, a in enumerate(acts):
-        _, r, term, trunc, info = env.step(np.array([a], np.float32))
+    for k in range(n):
+        obs, r, term, trunc, info = env.step(np.array([act(obs, k)], np.float32))
         ret += info["reward_unscaled"]
         if (k + 1) % every == 0:
             frames.append(env.render())
@@ -51,9 +72,9 @@ def run(schedule: str, every: int, seconds: float):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--other", default="trapezoid",
-                    help="schedule of the right panel (agents.schedules: trapezoid, "
-                         "zv_trapezoid; default %(default)s)")
+    ap.add_argument("--other", default="ppo_vector",
+                    help="right panel: a schedule (agents.schedules) or a trained baseline "
+                         "of the run cache (default %(default)s)")
     ap.add_argument("--every", type=int, default=4, help="keep every n-th step (default 4)")
     ap.add_argument("--seconds", type=float, default=30.0)
     ap.add_argument("--scale", type=float, default=0.6)

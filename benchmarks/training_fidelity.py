@@ -277,8 +277,8 @@ def main():
              f"error of {e_fast[0]:.1e} m and a force error of {e_fast[2]:.1e} of the range."]
     if a.whole_process:
         notes += ["", "Whole process (`python benchmarks/training_fidelity.py --env-episode "
-                  "train`: import, reset and one 600-step episode of "
-                  "`TelescopicBoomEnv(fidelity=\"train\")`, timed from outside, pinned to core "
+                  "converged`: import, reset and one 600-step episode of "
+                  "`TelescopicBoomEnv(fidelity=\"converged\")`, timed from outside, pinned to core "
                   f"0): {a.whole_process}"]
     lines = ["# Training fidelity of the full model: mesh, tolerance and integrator", "",
              "Written by `benchmarks/training_fidelity.py` (its docstring describes the episode, "

@@ -7,7 +7,7 @@ cylinder follows the one piston length L_s) at one of two fidelities (``FIDELITI
 * ``"paper"``: ``n_nodes`` = 3 nodes per spline element (2 sub-elements), RK45 at rtol 1e-6,
   atol 1e-7: the settings of ``TelescopicBoomEnv(fidelity="paper")``, a real-time factor of
   about 2.4 on one core frictionless (benchmarks/results/env_speed.md);
-* ``"train"``: the training fidelity chosen from the convergence table
+* ``"converged"``: the paper's mesh at a training tolerance, chosen from the convergence table
   benchmarks/results/training_fidelity.md (mesh, tolerance and integrator: ``FIDELITIES``),
   meant with friction on: the paper's 8 sub-elements per spline element, RK45 at rtol 1e-4,
   atol 1e-5; against the paper-accuracy run (the paper scene's own settings, rtol 1e-6) on the
@@ -42,7 +42,7 @@ from sim_core import Command, Simulation, load_scene
 from sim_core.rom import allowed_ranges, tables_for
 
 #: fidelity -> full-model settings: nodes per spline element (n_nodes - 1 sub-elements) and
-#: the [solver] table.  "train": the fastest case of benchmarks/results/training_fidelity.md
+#: the [solver] table.  "converged": the fastest case of benchmarks/results/training_fidelity.md
 #: within its error bounds on the paper's extraction with friction (tip within the env's 0.2 mm
 #: success tolerance, cylinder force within 5 % of its range, of the paper scene's own
 #: settings): the paper's mesh (coarser meshes ring at other frequencies: 3-18 mm of tip
@@ -51,7 +51,7 @@ from sim_core.rom import allowed_ranges, tables_for
 #: factor of ~0.4 on one core, far below the goal of 10 (see the table).
 FIDELITIES = {
     "paper": {"n_nodes": 3, "solver": {"rtol": 1e-6, "atol": 1e-7, "method": "RK45"}},
-    "train": {"n_nodes": 9, "solver": {"rtol": 1e-4, "atol": 1e-5, "method": "RK45"}},
+    "converged": {"n_nodes": 9, "solver": {"rtol": 1e-4, "atol": 1e-5, "method": "RK45"}},
 }
 SCENES = {3: "telescopic_extraction", 5: "telescopic_extraction_5"}
 DEFAULT_PAYLOAD = {3: 25000.0, 5: 10000.0}   # kg: the scenes'
@@ -61,14 +61,14 @@ class FullPhysicsPlant:
     """The full sim_core model of the telescopic crane, advanced one control step at a time
     along a prescribed stroke history (module docstring).
 
-    ``booms``: 3 or 5; ``fidelity``: "paper" or "train" (``FIDELITIES``); ``payload`` kg
+    ``booms``: 3 or 5; ``fidelity``: "paper" or "converged" (``FIDELITIES``); ``payload`` kg
     (default 25 t for 3 booms, 10 t for 5) and ``angle_deg`` (luffing angle, deg) within the
     modal tables' ranges; ``stroke0``: the piston length L_s at the start (m, at rest in static
     equilibrium); ``friction``: the sliders' Coulomb friction (Section 8); ``payload_swing``,
     ``rope_length`` (m): the payload on the hoist rope; ``n_nodes``: overrides the fidelity's
     nodes per spline element (3..33)."""
 
-    def __init__(self, booms: int = 3, fidelity: str = "train", payload: float | None = None,
+    def __init__(self, booms: int = 3, fidelity: str = "converged", payload: float | None = None,
                  angle_deg: float = 60.0, stroke0: float = 2.0, friction: bool = True,
                  payload_swing: bool = False, rope_length: float | None = None,
                  n_nodes: int | None = None):

@@ -18,6 +18,16 @@ observations into the batch.  A vector env in ``AutoresetMode.SAME_STEP`` is tak
 (its ``final_obs`` / ``final_info`` become the SB3 infos).  ``seed`` / ``set_options`` go to the
 next reset, as SB3 documents; the seeds are Gymnasium's (sub-env i gets seed + i).
 
+Desynchronised starts (``desync_steps`` = H > 0): every sub-env starts its episode at t = 0,
+so with episodes of T steps and rollouts of n_steps << T every rollout of a fresh vector env
+sees all sub-envs at the same time of their episodes, and every episode ends in the same
+rollout: the batch is correlated in time.  After each :meth:`reset` of the whole vector env,
+sub-env i stands still (action 0) for a number of steps drawn uniformly from [0, H) and is then
+reset again, so the first episodes the learner sees start spread over H steps of the clock
+(the draws from ``numpy.random.default_rng(desync_seed)``, a fresh generator per reset; a
+sub-env whose episode ends while it waits is reset at once).  Rewards of the waiting steps are
+discarded.
+
 Infos: one dict per sub-env with the vector env's info entries of that sub-env (where its mask
 ``_key`` is set), plus the SB3 keys above.  Forming N dicts per step costs Python time that the
 native vector env itself does not spend; ``info_keywords`` limits them to the keys named (None:
@@ -36,9 +46,14 @@ from stable_baselines3.common.vec_env import VecEnv
 class SB3VecEnv(VecEnv):
     """An SB3 VecEnv over a Gymnasium VectorEnv (module docstring)."""
 
-    def __init__(self, venv, info_keywords: Sequence[str] | None = None):
+    def __init__(self, venv, info_keywords: Sequence[str] | None = None,
+                 desync_steps: int = 0, desync_seed: int | None = None):
         self.venv = venv
         self.info_keywords = None if info_keywords is None else tuple(info_keywords)
+        if isinstance(desync_steps, bool) or not isinstance(desync_steps, (int, np.integer)) \
+                or desync_steps < 0:
+            raise ValueError(f"desync_steps = {desync_steps!r}: an integer >= 0 (steps)")
+        self.desync_steps, self.desync_seed = int(desync_steps), desync_seed
         mode = venv.metadata.get("autoreset_mode", AutoresetMode.NEXT_STEP)
         if isinstance(mode, str):
             mode = AutoresetMode(mode)
@@ -78,6 +93,24 @@ class SB3VecEnv(VecEnv):
         self.reset_infos = self._split_infos(infos, self.num_envs)
         self._reset_seeds()
         self._reset_options()
+        if self.desync_steps:
+            obs = self._desynchronise(obs)
+        return obs
+
+    def _desynchronise(self, obs: np.ndarray) -> np.ndarray:
+        """Sub-env i stands still for a uniform draw of [0, desync_steps) steps, then is reset
+        (module docstring); the batch's observations after the last of these resets."""
+        n, horizon = self.num_envs, self.desync_steps
+        when = np.random.default_rng(self.desync_seed).integers(0, horizon, n)
+        zero = np.zeros((n, *self.action_space.shape), self.action_space.dtype)
+        for j in range(horizon):
+            obs, _, term, trunc, _ = self.venv.step(zero)
+            mask = (when == j) | term | trunc
+            if mask.any():
+                obs, infos = self.venv.reset(options={"reset_mask": mask})
+                resets = self._split_infos(infos, n)
+                for i in np.flatnonzero(mask):
+                    self.reset_infos[i] = resets[i]
         return obs
 
     def step_async(self, actions: np.ndarray) -> None:

@@ -39,9 +39,9 @@ stroke kinematics (below) as one command.
   current state.  Slow: ~50 env steps/s, a real-time factor of ~2.4 on one core at the default
   3 nodes frictionless, and a reset of ~0.3 s (benchmarks/results/env_speed.md); for checking
   policies, not for training.
-* ``"train"``: the full nonlinear model with the sliders' friction on (Section 8), at the
+* ``"converged"``: the full nonlinear model with the sliders' friction on (Section 8), at the
   settings chosen from the convergence table benchmarks/results/training_fidelity.md (mesh,
-  tolerance and integrator, ``boom_env.full_physics.FIDELITIES["train"]``: the paper's 8
+  tolerance and integrator, ``boom_env.full_physics.FIDELITIES["converged"]``: the paper's 8
   sub-elements per spline element, RK45 at rtol 1e-4, atol 1e-5): against the paper-accuracy
   run of the paper's extraction its tip is within 0.03 mm and its cylinder force within 0.5 %
   of the force's range.  A real-time factor of only ~0.4 on one core, slower than ``"paper"``
@@ -86,7 +86,7 @@ Observation space
 
 The deflection is the tip position (innermost boom N = ``booms``, s = 10 m) minus the
 static-equilibrium tip of the same model at the current L_s (tables of the full model), i.e. the
-vibration plus the quasi-static inertial deflection.  With ``fidelity="paper"`` or ``"train"``
+vibration plus the quasi-static inertial deflection.  With ``fidelity="paper"`` or ``"converged"``
 the reference is the full model's own equilibrium tip at reset moved by the tables' static tip
 change (the tables interpolate between their stroke grid points, ~0.02 mm off the model's
 equilibrium).
@@ -189,7 +189,7 @@ The registered ids keep ``-v0``; their reward and observation changed as listed 
 * The ``booms`` option (3 default: unchanged; 5: the five-section crane, its own payload range
   and default payload, deflection scales and success tolerances 10 times the three-boom ones,
   ``info["booms"]``); ``d_ref``, ``dv_ref`` as constructor arguments.
-* ``fidelity="train"`` (an additive option: the full model with friction at the settings of
+* ``fidelity="converged"`` (an additive option: the full model with friction at the settings of
   benchmarks/results/training_fidelity.md); the default ``"rl"`` and ``"paper"`` are unchanged
   (their trajectories are pinned by tests/env/test_env_public_api.py).
 """
@@ -217,7 +217,7 @@ DEFAULT_PAYLOAD = {3: 25000.0, 5: 10000.0}   # kg: the paper scene's; the 5-sect
 DEFLECTION_REFS = {"d_ref": 1e-3, "dv_ref": 1e-2, "tol_deflection": 2e-4,
                    "tol_deflection_rate": 2e-3}
 DEFLECTION_SCALE = {3: 1.0, 5: 10.0}
-FIDELITIES = ("rl", "paper", "train")
+FIDELITIES = ("rl", "paper", "converged")
 # the modal ROM's scene of each boom count (frictionless; model.reduction = "modal")
 MODAL_SCENES = {3: ("telescopic_extraction_rl", {}),
                 5: ("telescopic_extraction_5", {"model.reduction": "modal",
@@ -419,12 +419,12 @@ class TelescopicBoomEnv(gym.Env):
 
     @property
     def _ts(self):
-        """The full model's system (fidelity "paper"/"train"; diagnostics and tests)."""
+        """The full model's system (fidelity "paper"/"converged"; diagnostics and tests)."""
         return self.plant.system
 
     @property
     def _y(self):
-        """The full model's integrated state (z, z') (fidelity "paper"/"train")."""
+        """The full model's integrated state (z, z') (fidelity "paper"/"converged")."""
         return self.plant.state
 
     def _check_range(self, name, value, arg=None):
@@ -515,7 +515,7 @@ class TelescopicBoomEnv(gym.Env):
         else:
             self.plant = FullPhysicsPlant(
                 booms=self.booms, fidelity=self.fidelity, payload=payload, angle_deg=angle,
-                stroke0=L0, friction=True if self.fidelity == "train" else self.paper_friction,
+                stroke0=L0, friction=True if self.fidelity == "converged" else self.paper_friction,
                 n_nodes=self.paper_n_nodes if self.fidelity == "paper" else None)
             self.tables = tables_for(payload, angle, self.n_modes, n_booms=self.booms)
         self._defl = np.zeros(4)

@@ -48,7 +48,7 @@ Fidelity (``fidelity``)
 -----------------------
 * ``"rl"`` (default): the batched ROM above (one compiled call per step for all cranes of the
   native vector env; env steps per second on one core: benchmarks/results/vector_env_speed.md).
-* ``"paper"``, ``"train"``: the full sim_core model with the payload on its hoist rope
+* ``"paper"``, ``"converged"``: the full sim_core model with the payload on its hoist rope
   (``boom_env.full_physics.FullPhysicsPlant``, its fidelities; the scene's 500 kg hook hangs
   with the payload, the rope's unstretched length is the loaded ``rope_length`` over
   1 + m g / EA) driven along the piston kinematics, the full model's own slider friction with
@@ -162,7 +162,7 @@ Version history
   stages behind the oil column (``friction``, on by default; ``info["stuck"]``); reference
   scales and success tolerances of the deflection for cm-scale deflections; a native vector
   env (``vector_entry_point``, autoreset NEXT_STEP); fidelities "rl" (ROM) and "paper" /
-  "train" (full model, scalar env); render exaggeration 20x.
+  "converged" (full model, scalar env); render exaggeration 20x.
 * v0: ``boom_env.telescopic_env`` (payload fixed at the tip; its own version history).
 """
 
@@ -198,7 +198,7 @@ REFS = {3: {"d_ref": 0.05, "dv_ref": 0.08, "sway_ref": 0.05, "sway_rate_ref": 0.
 G = 9.81
 RESET_OPTIONS = ("payload", "luffing_angle_deg", "rope_length", "stroke_start",
                  "stroke_target", "sway")
-FIDELITIES = ("rl", "paper", "train")
+FIDELITIES = ("rl", "paper", "converged")
 HOIST_EA, HOOK_MASS = 2e8, 500.0             # N, kg: the crane scenes' hoist rope and hook
 
 

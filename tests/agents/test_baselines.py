@@ -85,3 +85,25 @@ def test_quick_all_rows(tmp_path):
     for row in B.ROWS:
         rec = json.loads((tmp_path / "runs" / "rows" / f"{row}.json").read_text())
         assert all(np.isfinite(r["returns"]).all() for r in rec["seeds"].values())
+
+
+def test_full_physics_column_runs_the_v1_task_on_the_full_model():
+    """The transfer column's episodes: the v1 env at fidelity FULL_FIDELITY, reset with the
+    evaluation seed (the ROM column's payload and angle), the policy acting on the full
+    model's observation; the returns equal a direct run of the scalar env (shortened to 1 s)."""
+    seed, kw = B.eval_seed(0), dict(t_max=1.0)
+    got = B.full_physics_returns(B.scripted_actor("cubic"), seed, 1, **kw)
+    env = gym.make(B.ENV_ID, fidelity=B.FULL_FIDELITY, **B.env_kwargs(**kw))
+    _, info0 = env.reset(seed=seed)
+    acts = B.schedule_actions("cubic")
+    total, k, done = 0.0, 0, False
+    while not done:
+        _, r, term, trunc, info = env.step(np.array([acts[k]], np.float32))
+        total += r
+        done = term or trunc
+        k += 1
+    assert k == 20 and info["fidelity"] == B.FULL_FIDELITY and not info["diverged"]
+    assert got == [total]
+    rom = gym.make(B.ENV_ID, **B.env_kwargs(**kw))
+    _, rinfo = rom.reset(seed=seed)
+    assert rinfo["payload"] == info0["payload"]

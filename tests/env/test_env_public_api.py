@@ -156,7 +156,7 @@ def test_plant_bad_arguments_name_the_field(kw, match):
 
 @pytest.mark.slow
 def test_train_fidelity_steps_the_full_model_with_friction():
-    """fidelity='train': the full model with friction at the training settings follows the env's
+    """fidelity='converged': the full model with friction at the training settings follows the env's
     stroke (the full model's stroke output equals the env's L_s to the constraint tolerance) and
     its deflection stays within the env's success tolerance (0.2 mm, the bound the training
     fidelity was chosen for in benchmarks/results/training_fidelity.md) of the same model at the
@@ -164,8 +164,8 @@ def test_train_fidelity_steps_the_full_model_with_friction():
     second at full acceleration."""
     from boom_env import TelescopicBoomEnv
     from boom_env.full_physics import FIDELITIES
-    train = FIDELITIES["train"]
-    env = TelescopicBoomEnv(fidelity="train")
+    train = FIDELITIES["converged"]
+    env = TelescopicBoomEnv(fidelity="converged")
     ref = TelescopicBoomEnv(fidelity="paper", paper_friction=True,
                             paper_n_nodes=train["n_nodes"])
     o, _ = env.reset(seed=0)

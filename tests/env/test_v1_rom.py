@@ -14,7 +14,13 @@ from sim_core.vector_rom import VectorROM
 
 
 def test_lumped_coefficients_equal_tables_for():
-    """The vectorised bilinear interpolation is tables_for's arithmetic (same bits)."""
+    """The vectorised bilinear interpolation is tables_for's arithmetic for the modal rows
+    (same bits).  The tip's stroke derivative tip_dL is the same at the tabulated angles; between
+    them tables_for turns it in the boom's frame while the batch interpolates its global
+    components, which shortens the turning vector by at most 1 - cos(7.5 deg) (the 15-degree
+    grid's half interval): 0.86 % (lumped_coefficients' docstring); the sag's stroke rate in it
+    (its transverse part) is interpolated in cos theta there and in theta here, which adds
+    a few tenths of a percent at full stroke: 1.5 % of |tip_dL| is allowed."""
     rng = np.random.default_rng(0)
     m = np.r_[20000.0, 30000.0, rng.uniform(20e3, 30e3, 4)]
     a = np.r_[45.0, 75.0, rng.uniform(45, 75, 4)]
@@ -22,7 +28,12 @@ def test_lumped_coefficients_equal_tables_for():
     for i in range(len(m)):
         tb = tables_for(m[i], a[i], 4)
         assert np.array_equal(coef[i], tb.coef)
-        assert np.array_equal(tip_dL[i], tb.tip_dL)
+        if a[i] in (45.0, 75.0):
+            assert np.array_equal(tip_dL[i], tb.tip_dL)
+        else:
+            scale = np.linalg.norm(tb.tip_dL, axis=1)
+            gap = np.linalg.norm(tip_dL[i] - tb.tip_dL, axis=1)
+            assert np.all(gap <= 0.015 * scale)
 
 
 def _v0_envs(payloads, angles, **kw):

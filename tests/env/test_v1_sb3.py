@@ -73,3 +73,50 @@ def test_ppo_learns_on_the_native_vector_env():
     obs = venv.reset()
     act, _ = model.predict(obs, deterministic=True)
     assert act.shape == (8, 1) and np.all(np.abs(act) <= 1.0)
+
+
+def test_desynchronised_starts_spread_the_episode_clocks():
+    """desync_steps = H: after reset, sub-env i has run H - 1 - w_i steps of its episode, w_i
+    the uniform draw of [0, H) from default_rng(desync_seed) (observation 4 is the time left,
+    t_max - k dt); the draws are the documented ones, and the same seed gives the same
+    batch."""
+    n, H, dt, t_max = 16, 40, 0.05, 30.0
+    venv = SB3VecEnv(gym.make_vec(IDS[0], num_envs=n, **RANDOM), desync_steps=H,
+                     desync_seed=7)
+    venv.seed(1)
+    obs = venv.reset()
+    when = np.random.default_rng(7).integers(0, H, n)
+    np.testing.assert_allclose(obs[:, 4], t_max - (H - 1 - when) * dt, atol=1e-4)
+    assert len(set(np.round(obs[:, 4], 3))) > n // 2
+    again = SB3VecEnv(gym.make_vec(IDS[0], num_envs=n, **RANDOM), desync_steps=H,
+                      desync_seed=7)
+    again.seed(1)
+    assert np.array_equal(again.reset(), obs)
+    with pytest.raises(ValueError, match="desync_steps"):
+        SB3VecEnv(gym.make_vec(IDS[0], num_envs=2), desync_steps=-1)
+
+
+def test_a_bounds_truncation_is_a_time_limit_truncation_for_sb3():
+    """Leaving the observation bounds truncates (info["diverged"]): the adapter passes it to
+    SB3 as a truncation (``TimeLimit.truncated``, the value bootstrapped from the last good
+    observation), as SB3's own DummyVecEnv over the scalar env does."""
+    from stable_baselines3.common.vec_env import DummyVecEnv
+    kw = dict(sway_limit=0.002)           # full acceleration swings the payload past 2 mrad
+    ours = SB3VecEnv(gym.make_vec(IDS[0], num_envs=2, **kw))
+    ref = DummyVecEnv([lambda: gym.make(IDS[0], **kw) for _ in range(2)])
+    ours.seed(0)
+    ref.seed(0)
+    ours.reset()
+    ref.reset()
+    a = np.ones((2, 1), np.float32)
+    for _ in range(200):
+        _, _, d1, i1 = ours.step(a)
+        _, _, d2, i2 = ref.step(a)
+        assert np.array_equal(d1, d2)
+        if d1.any():
+            break
+    assert d1.all()
+    for x, y in zip(i1, i2):
+        assert x["diverged"] and x["TimeLimit.truncated"]
+        assert y["TimeLimit.truncated"]
+        assert np.array_equal(x["terminal_observation"], y["terminal_observation"])

@@ -171,7 +171,7 @@ def test_full_physics_fidelity_of_the_v1_env_follows_the_rom():
     """fidelity="paper" steps the full model with the swinging payload (boom_env.full_physics,
     the scene's 500 kg hook added to the payload) along the env's stroke kinematics, on the
     mesh the modal tables were built from (3 nodes per spline element; the converged 9-node
-    mesh of fidelity="train" differs from it by millimetres, benchmarks/results/
+    mesh of fidelity="converged" differs from it by millimetres, benchmarks/results/
     training_fidelity.md): over the first 5 s of the cubic extraction its sway follows the
     ROM's within the motion-phase tolerance of the cubic comparison above (6 % of the peak)
     plus the hook's 2 % of the hanging mass.  The tip deflection is a few mm there, of which the

@@ -169,8 +169,13 @@ def lumped_coefficients(payloads, angles_deg, n_modes: int, n_booms: int = 3, pa
 
     Returns (L_grid (nL,) m, coef (N, nL, 8, n_modes) rows ``modal.COLS``, tip_dL (N, nL, 3)
     m/m, with its lateral part zeroed as ``tables_for`` does).  The arithmetic is that of
-    ``modal.tables_for`` (same results to the last bit).  Ranges are not checked here (the
-    caller checks them: :class:`sim_core.vector_rom.VectorROM`)."""
+    ``modal.tables_for`` for the modal rows (same results to the last bit) and for tip_dL at
+    the tabulated angles; between them ``tables_for`` turns tip_dL (about 2 e_s, a vector that
+    turns with the boom) in the boom's frame, while here its global components are
+    interpolated, which shortens it by at most 1 - cos(7.5 deg) = 0.86 % (the 15-degree grid's
+    half interval): the pendulum's forcing by the tip's horizontal velocity s v is that much
+    weaker between the grid angles.  Ranges are not checked here (the caller checks them:
+    :class:`sim_core.vector_rom.VectorROM`)."""
     r = load_raw(path, n_booms)
     P, A = r["payloads"], r["angles"]
     payloads = np.asarray(payloads, float).reshape(-1)
