@@ -666,9 +666,11 @@ def _transfer(caches: dict) -> str:
     p = paired(caches, "ppo_vector", key="full_returns")
     if p is not None and p[0] + 2 * p[1] < 0:
         out += ("  The large-batch PPO's advantage on the ROM does not transfer: on the full "
-                "model (its slider friction and flexible booms, where the ROM has an oil "
-                "column, a tabulated friction load and four modes) it scores below the "
-                "open-loop cubic schedule.")
+                "model it scores below the open-loop cubic schedule.  There the stroke follows "
+                "the commanded piston exactly (the sliders' friction acts on the booms; no oil "
+                "column), while in the ROM the stages stick and slip behind the oil column: a "
+                "feedback policy tuned to the ROM's stroke response overshoots "
+                "(docs/environment.md, v1's fidelities).")
     return out
 
 
@@ -753,13 +755,16 @@ def plot_curves(path: Path, caches: dict) -> None:
             cur = rec.get("curve") or []
             if cur:
                 x, y = zip(*cur)
-                ax.plot(x, y, label=f"seed {s}", lw=1)
+                ax.plot(x, y, label=f"seed {s}", lw=1, marker="o" if len(cur) < 10 else None,
+                        ms=3)
         if row != "ppo_residual":     # the residual's training return has its tracking term
             cc = caches.get("cubic", {"seeds": {}})["seeds"]
-            r = [x for v in cc.values() for x in v["returns"]]
+            key = "full_returns" if row == "ppo_finetune" else "returns"   # its plant's
+            r = [x for v in cc.values() for x in (v.get(key) or [])]
             if r:
                 ax.axhline(np.mean(r), color="k", ls="--", lw=0.8,
-                           label="cubic schedule (evaluation)")
+                           label="cubic schedule (evaluation" + (", full model)"
+                                                                 if key == "full_returns" else ")"))
         ax.set_title(LABELS[row], fontsize=9)
         ax.set_xlabel("env steps")
         ax.set_ylabel("training return" + (" (with tracking term)" if row == "ppo_residual"
