@@ -173,47 +173,16 @@ def sb3_actor(model_path, vecnorm_path=None, algo: str = "ppo"):
     return act
 
 
-class _SwayEnvLimits:
-    """Mixin: a_max, t_max of the v1 env as attributes (agents.wrappers.ScheduleTracker reads
-    them from ``env.unwrapped``)."""
-
-    @property
-    def a_max(self):
-        return self.core.a_max
-
-    @property
-    def t_max(self):
-        return self.core.t_max
-
-
-def _residual_env_class():
-    from boom_env.telescopic_sway_env import TelescopicSwayEnv
-    return type("SwayEnvWithLimits", (_SwayEnvLimits, TelescopicSwayEnv), {})
-
-
-RESIDUAL_ID = "agents_baselines/TelescopicExtractionLimits-v1"
-
-
-def _register_residual_id():
-    from gymnasium.envs.registration import register, registry
-
-    import boom_env  # noqa: F401
-    if RESIDUAL_ID not in registry:
-        spec = registry[ENV_ID]
-        register(id=RESIDUAL_ID, entry_point=_residual_env_class(),
-                 max_episode_steps=spec.max_episode_steps, kwargs=dict(spec.kwargs))
-
-
 def _residual_env(meta: dict, **kw):
     """A scalar v1 env (kwargs ``kw``) in the residual-on-schedule wrapper of the trained run
     ``meta`` (model_meta.json), without its training-only tracking reward."""
     import gymnasium as gym
 
+    import boom_env  # noqa: F401
     from .schedules import by_name
     from .wrappers import ResidualOnSchedule
-    _register_residual_id()
     res = meta["residual"]
-    env = gym.make(RESIDUAL_ID, **env_kwargs(**kw))
+    env = gym.make(ENV_ID, **env_kwargs(**kw))
     return ResidualOnSchedule(env, by_name(res["schedule"]), res["scale"], res["omega"], 0.0)
 
 
@@ -390,9 +359,8 @@ def train_residual(seed: int, steps: int, out: Path) -> dict:
     """agents.train_ppo.train with the residual on the cubic schedule, on v1 (randomised)."""
     from . import train_ppo as tp
     from .settings import RESIDUAL_ENV_KWARGS
-    _register_residual_id()
     old = tp.ENV_ID
-    tp.ENV_ID = RESIDUAL_ID          # the v1 env with a_max / t_max attributes
+    tp.ENV_ID = ENV_ID               # train_ppo trains on v0 by default
     try:
         t0 = time.perf_counter()
         path = tp.train(steps, seed, out, n_envs=2, vec="dummy", checkpoint_every=0,

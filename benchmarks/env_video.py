@@ -20,6 +20,7 @@ import argparse
 import io
 import os
 import sys
+from pathlib import Path
 
 import numpy as np
 
@@ -39,7 +40,6 @@ def actor(name: str):
     if name not in baselines.TRAINED or name == "ppo_residual":
         raise SystemExit(f"--other {name!r}: a schedule ({', '.join(schedules.NAMES)}) or "
                          "a trained baseline (ppo_vector, sac, ppo_scratch)")
-    from pathlib import Path
     cache = baselines.load_cache(Path(ROOT) / "agents" / "runs" / "baselines" / "rows" /
                                  f"{name}.json")
     rec = cache["seeds"].get("0")

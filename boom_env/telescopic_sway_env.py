@@ -571,7 +571,18 @@ class TelescopicSwayEnv(gym.Env):
 
     @property
     def dt(self) -> float:
+        """Control step, s."""
         return self.core.dt
+
+    @property
+    def a_max(self) -> float:
+        """Acceleration of action 1, m/s^2."""
+        return self.core.a_max
+
+    @property
+    def t_max(self) -> float:
+        """Episode length, s."""
+        return self.core.t_max
 
     def reset(self, *, seed=None, options=None):
         super().reset(seed=seed)

@@ -302,23 +302,23 @@ class VectorROM:
         the acceleration, end_stop (N,) bool: an end stop was hit or pressed, accel_applied
         (N,) m/s^2: the mean acceleration actually applied).  Non-finite accelerations raise
         ValueError."""
-        a = np.ascontiguousarray(accel, dtype=float).reshape(-1)
-        if a.shape != (self.n_envs,):
-            raise ValueError(f"accel of shape {np.shape(accel)}: expected ({self.n_envs},)")
-        if not np.all(np.isfinite(a)):
-            raise ValueError(f"accel: {int(np.sum(~np.isfinite(a)))} non-finite values")
-        return self._b.step(a)
+        return self._b.step(self._accel(accel))
 
     def step_outputs(self, accel):
         """:meth:`step` followed by :meth:`outputs`: returns (saturated, end_stop,
         accel_applied, tip_deflection (N, 4), sway (N, 4)), the same values as the two calls,
         computed in one compiled pass over the cranes (each crane's tables read once)."""
+        return self._b.step_outputs(self._accel(accel))
+
+    def _accel(self, accel) -> np.ndarray:
+        """``accel`` as a contiguous float array (N,); ValueError for another shape or a
+        non-finite value."""
         a = np.ascontiguousarray(accel, dtype=float).reshape(-1)
         if a.shape != (self.n_envs,):
             raise ValueError(f"accel of shape {np.shape(accel)}: expected ({self.n_envs},)")
         if not np.all(np.isfinite(a)):
             raise ValueError(f"accel: {int(np.sum(~np.isfinite(a)))} non-finite values")
-        return self._b.step_outputs(a)
+        return a
 
     # -- state and outputs -------------------------------------------------------------------
     @property
