@@ -12,7 +12,7 @@ cylinder follows the one piston length L_s) at one of two fidelities (``FIDELITI
   meant with friction on: the paper's 8 sub-elements per spline element, RK45 at rtol 1e-4,
   atol 1e-5; against the paper-accuracy run (the paper scene's own settings, rtol 1e-6) on the
   paper's extraction its tip is within 0.03 mm and its cylinder force within 0.5 % of the
-  force's range, at a real-time factor of only ~0.4 on one core (no setting reaches 10 at an
+  force's range, at a real-time factor of only ~0.5 on one core (no setting reaches 10 at an
   acceptable error with friction: the table).
 
 Each control step the caller hands the stroke kinematics of the step
@@ -30,6 +30,11 @@ other strokes).  With ``payload_swing`` the payload hangs on the hoist rope (len
 boom tip (``effects.payload_swing``, :mod:`sim_core.physics.hoist`) and :meth:`sway` gives its
 angles from the vertical and their rates.  The payload and luffing angle must lie in the modal
 tables' ranges (:func:`sim_core.rom.allowed_ranges`), which the static tip comes from.
+
+With ``oil_column`` the stroke kinematics are the piston's: the cylinder drives the stages
+through its oil column (``effects.oil_column``, :mod:`sim_core.physics.hydraulic_cylinder`), so
+with friction they stick and slip behind it; :meth:`FullPhysicsPlant.stroke` gives the stages'
+L_s and rate, and the deflection is read against the static tip at the stages' L_s.
 """
 
 from __future__ import annotations
@@ -48,7 +53,7 @@ from sim_core.rom import allowed_ranges, tables_for
 #: settings): the paper's mesh (coarser meshes ring at other frequencies: 3-18 mm of tip
 #: error) at a tenth of its tolerance; the explicit steps are stability-limited by the stress
 #: filter, so the looser tolerance saves only ~10 % and BDF/auto do not pay.  A real-time
-#: factor of ~0.4 on one core, far below the goal of 10 (see the table).
+#: factor of ~0.5 on one core, far below the goal of 10 (see the table).
 FIDELITIES = {
     "paper": {"n_nodes": 3, "solver": {"rtol": 1e-6, "atol": 1e-7, "method": "RK45"}},
     "converged": {"n_nodes": 9, "solver": {"rtol": 1e-4, "atol": 1e-5, "method": "RK45"}},
@@ -64,14 +69,20 @@ class FullPhysicsPlant:
     ``booms``: 3 or 5; ``fidelity``: "paper" or "converged" (``FIDELITIES``); ``payload`` kg
     (default 25 t for 3 booms, 10 t for 5) and ``angle_deg`` (luffing angle, deg) within the
     modal tables' ranges; ``stroke0``: the piston length L_s at the start (m, at rest in static
-    equilibrium); ``friction``: the sliders' Coulomb friction (Section 8); ``payload_swing``,
-    ``rope_length`` (m): the payload on the hoist rope; ``n_nodes``: overrides the fidelity's
-    nodes per spline element (3..33)."""
+    equilibrium); ``friction``: the sliders' Coulomb friction (Section 8; ``mu`` = (static,
+    dynamic) coefficients, default the scene's 0.15, 0.1); ``oil_column``: the telescopic
+    cylinder drives the stages through its oil column (``effects.oil_column``; ``hydraulics``:
+    the ``[oil_column]`` table's cylinder_area, bulk_modulus, dead_length, damping_ratio, default
+    the scene's), so that the commanded stroke is the piston's and the stages lag it, sticking
+    and slipping with friction (:meth:`stroke`); ``payload_swing``, ``rope_length`` (m): the
+    payload on the hoist rope; ``n_nodes``: overrides the fidelity's nodes per spline element
+    (3..33)."""
 
     def __init__(self, booms: int = 3, fidelity: str = "converged", payload: float | None = None,
                  angle_deg: float = 60.0, stroke0: float = 2.0, friction: bool = True,
                  payload_swing: bool = False, rope_length: float | None = None,
-                 n_nodes: int | None = None):
+                 n_nodes: int | None = None, oil_column: bool = False,
+                 hydraulics: dict | None = None, mu: tuple[float, float] | None = None):
         if fidelity not in FIDELITIES:
             raise ValueError(f"fidelity = {fidelity!r}: allowed {', '.join(map(repr, FIDELITIES))}")
         if isinstance(booms, bool) or booms not in SCENES:
@@ -99,7 +110,16 @@ class FullPhysicsPlant:
             overrides["effects.payload_swing"] = True
             if rope_length is not None:
                 overrides["hoist.length"] = float(rope_length)
+        if hydraulics is not None and not oil_column:
+            raise ValueError("hydraulics configures the oil column: set oil_column=True (or "
+                             "leave hydraulics None)")
+        if oil_column:
+            overrides["effects.oil_column"] = True
+            overrides.update({f"oil_column.{k}": float(v) for k, v in (hydraulics or {}).items()})
+        if mu is not None:
+            overrides["contact.mu_static"], overrides["contact.mu_dynamic"] = map(float, mu)
         self.booms, self.fidelity, self.payload_swing = booms, fidelity, bool(payload_swing)
+        self.oil_column = bool(oil_column)
         self.scene = load_scene(SCENES[booms], overrides=overrides)
         self.sim = Simulation(self.scene)
         self.tables = tables_for(payload, float(angle_deg), 1, n_booms=booms)
@@ -130,6 +150,13 @@ class FullPhysicsPlant:
         """Stroke rate L_s' (m/s) now."""
         return self.sim.outputs(("actuators",))["actuators"]["telescopic"][1]
 
+    def stroke(self) -> tuple[float, float]:
+        """(L_s, L_s'): the stages' stroke (m, the first cylinder's length) and rate (m/s)
+        now; with the oil column they lag the commanded piston (:attr:`L`, :attr:`v`), else
+        they equal it (to the constraint's round-off)."""
+        L, Ld = self.sim.outputs(("telescopic_stroke",))["telescopic_stroke"]
+        return float(L), float(Ld)
+
     @property
     def t(self) -> float:
         """Simulated time since the start, s."""
@@ -141,9 +168,14 @@ class FullPhysicsPlant:
 
     def tip_deflection(self) -> tuple[float, float, float, float]:
         """(dX, dZ, dX', dZ') of the tip relative to the static tip at the current L_s (m, m/s;
-        module docstring), global X (horizontal, in the luffing plane) and Z (up)."""
-        out = self.sim.outputs(("tip_position", "tip_velocity", "actuators"))
-        L, Ld, _ = out["actuators"]["telescopic"]
+        module docstring; with the oil column the stages' L_s), global X (horizontal, in the
+        luffing plane) and Z (up)."""
+        if self.oil_column:      # the static tip of the stages' stroke, not the piston's
+            out = self.sim.outputs(("tip_position", "tip_velocity", "telescopic_stroke"))
+            L, Ld = out["telescopic_stroke"]
+        else:
+            out = self.sim.outputs(("tip_position", "tip_velocity", "actuators"))
+            L, Ld, _ = out["actuators"]["telescopic"]
         rs, drs = self.tables.static_tip(L)
         d = out["tip_position"] - rs - self._tip_offset
         dv = out["tip_velocity"] - drs * Ld

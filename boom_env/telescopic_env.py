@@ -44,7 +44,7 @@ stroke kinematics (below) as one command.
   tolerance and integrator, ``boom_env.full_physics.FIDELITIES["converged"]``: the paper's 8
   sub-elements per spline element, RK45 at rtol 1e-4, atol 1e-5): against the paper-accuracy
   run of the paper's extraction its tip is within 0.03 mm and its cylinder force within 0.5 %
-  of the force's range.  A real-time factor of only ~0.4 on one core, slower than ``"paper"``
+  of the force's range.  A real-time factor of only ~0.5 on one core, slower than ``"paper"``
   (frictionless on 2 sub-elements): with friction the coarser meshes are millimetres off and
   no setting of the table reaches a real-time factor of 10.  ``paper_n_nodes`` and
   ``paper_friction`` do not apply.

@@ -51,9 +51,15 @@ Fidelity (``fidelity``)
 * ``"paper"``, ``"converged"``: the full sim_core model with the payload on its hoist rope
   (``boom_env.full_physics.FullPhysicsPlant``, its fidelities; the scene's 500 kg hook hangs
   with the payload, the rope's unstretched length is the loaded ``rope_length`` over
-  1 + m g / EA) driven along the piston kinematics, the full model's own slider friction with
-  ``friction=True`` (it has no oil column: its stroke is the piston's).  The scalar env only;
-  slow (a few env steps per second): for checking policies.
+  1 + m g / EA) driven along the piston kinematics.  With ``friction=True`` the full model's
+  cylinder drives the stages through its oil column (``effects.oil_column``: the same
+  ``cylinder_area``, ``bulk_modulus``, ``dead_length``, ``hydraulic_damping`` and friction
+  coefficients as the ROM's stroke friction) against its own slider friction (Section 8), so
+  its stages stick and slip behind the piston as the ROM's do; the observed L_s, its rate and
+  the applied acceleration are then its stages' (``info["stuck"]``: their rate within the
+  friction law's stick band, |L_s'| < 0.01 m/s).  ``friction=False``: the stages follow the
+  piston exactly.  The scalar env only; slow (a few env steps per second): for checking
+  policies.
 
 Action space
 ------------
@@ -162,7 +168,9 @@ Version history
   stages behind the oil column (``friction``, on by default; ``info["stuck"]``); reference
   scales and success tolerances of the deflection for cm-scale deflections; a native vector
   env (``vector_entry_point``, autoreset NEXT_STEP); fidelities "rl" (ROM) and "paper" /
-  "converged" (full model, scalar env); render exaggeration 20x.
+  "converged" (full model, scalar env); render exaggeration 20x.  The full-model fidelities
+  with friction drive the stages through the cylinder's oil column, as the ROM does (before,
+  the full model's stages followed the piston exactly while the ROM's stuck and slipped).
 * v0: ``boom_env.telescopic_env`` (payload fixed at the tip; its own version history).
 """
 
@@ -299,6 +307,17 @@ class SwayTask:
                       hydraulic_damping=_positive("hydraulic_damping", hydraulic_damping, 0.99))
         self.full = fidelity != "rl"
         self.plant = None
+        # the full model with friction drives its stages through the oil column of the same
+        # hydraulic parameters and friction coefficients as the ROM's stroke friction
+        self._plant_kw = {}
+        if self.full and self.friction:
+            self._plant_kw = dict(
+                oil_column=True, mu=(fr.get("mu_static", 0.15), fr.get("mu_dynamic", 0.1)),
+                hydraulics=dict(cylinder_area=fr["cylinder_area"],
+                                bulk_modulus=fr["bulk_modulus"], dead_length=fr["dead_length"],
+                                damping_ratio=fr["hydraulic_damping"]))
+        # the stages' stroke and rate (m, m/s) where the full model's oil column sets them
+        self.stage = np.zeros((self.n, 2))
         # the full model takes its friction itself; the ROM then only provides the kinematics
         rom_friction = self.friction and not self.full
         self.rom = VectorROM(self.n, booms=self.booms, n_modes=self.n_modes, payload_swing=True,
@@ -398,7 +417,9 @@ class SwayTask:
             L0_rope = float(ell[0]) / (1.0 + (m[0] + HOOK_MASS) * G / HOIST_EA)
             self.plant = FullPhysicsPlant(self.booms, self.fidelity, float(m[0]), float(ang[0]),
                                           stroke0=L0, friction=self.friction,
-                                          payload_swing=True, rope_length=L0_rope)
+                                          payload_swing=True, rope_length=L0_rope,
+                                          **self._plant_kw)
+            self.stage[0] = self.plant.stroke()
         self.L_target[ids] = Lt
         self.travel[ids] = max(abs(Lt - L0), 1e-3)
         self.t[ids] = 0.0
@@ -445,6 +466,11 @@ class SwayTask:
                 self.plant.advance(segs, self.dt, end=(L1, v1))
                 defl_new = np.array([self.plant.tip_deflection()])
                 sway_new = np.array([self.plant.sway()])
+                if self._plant_kw:
+                    # the stages behind the oil column: their mean acceleration over the step
+                    L_st, v_st = self.plant.stroke()
+                    acc = np.array([(v_st - self.stage[0, 1]) / self.dt])
+                    self.stage[0] = L_st, v_st
             except (SimulationError, FloatingPointError, np.linalg.LinAlgError) as exc:
                 failed = f"{type(exc).__name__}: {exc}"
                 defl_new = np.full((1, 4), np.nan)
@@ -457,7 +483,8 @@ class SwayTask:
         settled = np.empty(n, bool)
         truncated = np.empty(n, bool)
         code = np.empty(n, np.int8)
-        kernel.task_step(self.par, self.rom.stroke, self.rom.stroke_rate, acc, stop, defl_new,
+        L, v = self._stroke()
+        kernel.task_step(self.par, L, v, acc, stop, defl_new,
                          sway_new, self.defl, self.sway, a, self.a_prev, self.L_target,
                          self.travel, self.t, self.steps, self.params, self._low64,
                          self._high64, obs, self.last_obs, reward, ru, settled, truncated, code)
@@ -476,10 +503,17 @@ class SwayTask:
                                  f"{self.sway_limit:g} rad, rate {self.rate_max:.3g} rad/s)")
         return obs, reward, settled, truncated, diverged, reason
 
+    def _stroke(self):
+        """(L_s, L_s') arrays (n,) of the stages: the full model's behind its oil column, else
+        the ROM's."""
+        if self._plant_kw:
+            return self.stage[:, 0].copy(), self.stage[:, 1].copy()
+        return self.rom.stroke, self.rom.stroke_rate
+
     def _obs(self, ids):
-        rom = self.rom
+        L, v = self._stroke()
         out = np.empty((len(ids), len(self.obs_low)))
-        kernel.observe(rom.stroke[ids], rom.stroke_rate[ids], self.a_applied[ids],
+        kernel.observe(L[ids], v[ids], self.a_applied[ids],
                        self.L_target[ids], self.t[ids], self.t_max, self.defl[ids],
                        self.sway[ids], self.params[ids], self._low64, self._high64, out)
         return out.astype(np.float32)
@@ -487,13 +521,17 @@ class SwayTask:
     def info_arrays(self, diverged, reason, success, reward_unscaled):
         """Per-crane info as arrays (n, ...)."""
         rom = self.rom
-        return {"time": self.t.copy(), "stroke": rom.stroke.copy(),
-                "stroke_rate": rom.stroke_rate.copy(), "velocity_saturated": self.sat.copy(),
+        L, v = self._stroke()
+        # stuck: the ROM's stick state, or the full model's stages within its friction law's
+        # stick band |L_s'| < v_eps (0.01 m/s, the scene's)
+        stuck = np.abs(v) < 0.01 if self._plant_kw else rom.stuck
+        return {"time": self.t.copy(), "stroke": np.array(L), "stroke_rate": np.array(v),
+                "velocity_saturated": self.sat.copy(),
                 "end_stop": self.stop.copy(), "tip_deflection": self.defl[:, :2].copy(),
                 "sway": self.sway[:, :2].copy(), "payload": rom.payload.copy(),
                 "luffing_angle_deg": rom.luffing_angle_deg.copy(),
                 "rope_length": rom.rope_length.copy(), "booms": self._booms.copy(),
-                "stuck": rom.stuck,
+                "stuck": stuck,
                 "diverged": np.array(diverged, bool),
                 "reason": np.array(reason, dtype=object),
                 "success": np.array(success, bool),
@@ -513,7 +551,7 @@ class SwayTask:
         ax.clear()
         ang = float(self.rom.luffing_angle_deg[i])
         O, e = luffing_frame(ang)
-        L = float(self.rom.stroke[i])
+        L = float(self._stroke()[0][i])
         d = exaggeration * self.defl[i, :2]
         n = self.booms
         total = (n - 1) * L + BOOM_LENGTH

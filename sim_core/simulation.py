@@ -86,9 +86,10 @@ class Simulation:
         """The scene's outputs at the current time (SI units), ``time`` and every actuator's
         (position, rate, acceleration) under ``actuators``.  ``names`` (optional): only these
         outputs; for the full model, names among ``time``, ``actuators``, ``tip_position``,
-        ``tip_velocity`` and, with a swinging payload, ``payload_position``,
-        ``payload_velocity``, ``sway_angle``, ``sway_rate`` skip the forces and the contact
-        solution.  KeyError for a name the scene does not output."""
+        ``tip_velocity``, ``telescopic_stroke`` (the stages' L_s and L_s': with
+        ``effects.oil_column`` they lag the commanded piston of ``actuators``) and, with a
+        swinging payload, ``payload_position``, ``payload_velocity``, ``sway_angle``,
+        ``sway_rate`` skip the forces and the contact solution.  KeyError for a name the scene does not output."""
         return self._impl.outputs(names)
 
     def save_state(self) -> dict:

@@ -148,6 +148,8 @@ def test_plant_sway_rate_is_the_derivative_of_the_sway_angle():
     ({"booms": 4}, "booms = 4"),
     ({"payload": 1000.0}, "payload = 1000.0 outside"),
     ({"rope_length": 5.0}, "rope_length"),
+    ({"hydraulics": {"bulk_modulus": 2e9}}, "hydraulics"),
+    ({"oil_column": True, "hydraulics": {"bulk_modulus": -1.0}}, "bulk_modulus"),
 ])
 def test_plant_bad_arguments_name_the_field(kw, match):
     with pytest.raises(ValueError, match=match):

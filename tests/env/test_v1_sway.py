@@ -197,3 +197,42 @@ def test_full_physics_fidelity_of_the_v1_env_follows_the_rom():
     assert np.max(np.abs(out["rl"][:, 2] - out["paper"][:, 2])) <= 0.08 * peak
     d_peak = np.max(np.abs(out["paper"][:, :2]))
     assert np.max(np.abs(out["rl"][:, :2] - out["paper"][:, :2])) <= 0.25 * d_peak
+
+
+@pytest.mark.slow
+def test_full_physics_stages_stick_and_slip_as_the_roms():
+    """With friction the full model's cylinder drives the stages through its oil column
+    (effects.oil_column, the ROM's hydraulic parameters) against its own slider friction, the
+    ROM's stages through the same column against mu N of the tabulated normal load: over the
+    first 10 s of the cubic extraction both hold still and break away at the same steps
+    (info["stuck"]), and their strokes differ by less than the column's largest compression
+    before breakaway, mu_s N / k_h at the start (the full model's regularised law creeps a
+    little before it; the ROM's breakaway is exact)."""
+    import gymnasium as gym
+
+    import boom_env  # noqa: F401
+    from agents.schedules import cubic
+    acts = cubic().actions(0.05, 0.25, 200)
+    out = {}
+    for fid in ("rl", "paper"):
+        env = gym.make("boom_env/TelescopicExtraction-v1", fidelity=fid)
+        env.reset(seed=0)
+        rows = []
+        for a in acts:
+            obs, r, term, trunc, info = env.step(np.array([a], np.float32))
+            assert not info["diverged"], info["reason"]
+            rows.append((obs[0], bool(info["stuck"])))
+        out[fid] = rows
+    L_rom = np.array([r[0] for r in out["rl"]])
+    L_full = np.array([r[0] for r in out["paper"]])
+    stuck_rom = np.array([r[1] for r in out["rl"]])
+    stuck_full = np.array([r[1] for r in out["paper"]])
+    assert stuck_rom[:10].all() and not stuck_rom[20:].any()
+    assert np.array_equal(stuck_rom, stuck_full)
+    from sim_core.vector_rom import VectorROM
+    probe = VectorROM(1, booms=3, payload_swing=True, friction=True)
+    probe.configure(np.array([25000.0]), np.array([60.0]), np.array([5.0]))
+    probe.reset(2.0)
+    # the env's defaults: 25 t at 60 deg, mu_s 0.15, k_h = beta A / (L_s + l_0) at L_s = 2 m
+    lag = 0.15 * float(probe.normal_load()[0]) / (1e9 * 0.02 / (2.0 + 0.5))
+    assert np.max(np.abs(L_full - L_rom)) < lag, (np.max(np.abs(L_full - L_rom)), lag)

@@ -707,6 +707,7 @@ CONTEXTS = {
         ("crane_hexagonal_4", {"boom.0.section": PROPS_SECTION,
                                "effects.contact_distribution": False}),
         ("telescopic_extraction_rl", {}),
+        ("telescopic_extraction", {"effects.oil_column": True}),
     ],
     "folding": [("folding_boom", {})],
 }

@@ -58,6 +58,7 @@ from sim_core.physics.constraints import (
 from sim_core.physics.drive_profiles import CubicSmoothstepSchedule, HoldProfile
 from sim_core.physics.hoist import HangingMass, HoistRope, free_point
 from sim_core.physics.effects import Effect, Elasticity, Gravity, Inertia, StressFilter
+from sim_core.physics.hydraulic_cylinder import OilColumn
 from sim_core.physics.point_effects import PointMass, RopeDrive, SliderSeat
 from sim_core.physics.rigid_body import beam_frame, revolute_axis, turntable_frame
 from sim_core.systems.telescopic.luffing import cylinder_drive, luffing_geometry
@@ -97,6 +98,9 @@ class TelescopicSystem:
     slew_angle: object = None                   # t -> slew angle (rad) where the crane slews
     i_phi: int | None = None                    # the turntable's slew-angle coordinate
     plugin_effects: list = field(default_factory=list)  # (EffectPlugin, its Effect)
+    # the cylinders driven through their oil column (effects.oil_column): drive name ->
+    # physics.hydraulic_cylinder.OilColumn, in place of the drive's constraint row
+    oil_columns: dict = field(default_factory=dict)
 
 
 def _section_outline(ts: "TelescopicSystem", k: int) -> np.ndarray:
@@ -156,6 +160,14 @@ def rope_static_tension(p: TelescopicParams, j: int) -> float:
     masses = [p.lengths[i] * boom_section(i, p).rhoA for i in range(p.n_booms)]
     hanging = p.payload + (p.hook_mass if p.payload_swing else 0.0)
     return (sum(masses[j:]) + hanging) * p.gravity * math.sin(math.radians(p.luffing_angle_deg))
+
+
+def stroke_mass_of(p: TelescopicParams) -> float:
+    """The stages' and payload's rigid-body mass on the stroke M_s (kg) of the synchronized
+    drive (:func:`sim_core.systems.telescopic.friction_table.stroke_mass`; the hook hangs with
+    a swinging payload)."""
+    from sim_core.systems.telescopic.friction_table import boom_masses, stroke_mass
+    return stroke_mass(boom_masses(p), p.payload + (p.hook_mass if p.payload_swing else 0.0))
 
 
 def stage_schedules(p: TelescopicParams) -> list[CubicSmoothstepSchedule]:
@@ -325,11 +337,20 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
                                                        sign=p.direction, s0=Ls)
     stages = stage_schedules(p)
     cylinders, rope_booms = drive_layout(N, p.mechanism)
-    drives = []
+    drives, columns = [], {}
     for k in cylinders:
         name = drive_name(k, p.mechanism)
-        add(distance_driver(name, mp(k + 1, s_fixed=0.0), mp(k, s_fixed=0.0),
-                            _length_of(stages[k])))
+        ends = (mp(k + 1, s_fixed=0.0), mp(k, s_fixed=0.0))
+        if p.oil_column is None:
+            add(distance_driver(name, *ends, _length_of(stages[k])))
+        else:
+            # the cylinder through its oil column (physics.hydraulic_cylinder); its static
+            # force F0 comes from the constrained equilibrium (initial_equilibrium)
+            oc = p.oil_column
+            columns[name] = OilColumn(ends, _length_of(stages[k]),
+                                      kA=oc["bulk_modulus"] * oc["cylinder_area"],
+                                      dead_length=oc["dead_length"], zeta=oc["damping_ratio"],
+                                      stroke_mass=stroke_mass_of(p), name=name)
         drives.append(name)
     model.nonlinear = cons
     rows, i = {}, 0
@@ -384,9 +405,10 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
             rows[bn] = slice(i, i + 1)
             i += 1
             model.nonlinear = cons
-    model.point_effects = pe + list(seats.values())
+    model.point_effects = pe + list(seats.values()) + list(columns.values())
     ts = TelescopicSystem(model, Q0, sched, s2_index, s3_index, rows, tip, p,
                           angle_rows=angle_rows, seats=seats, drives=drives, ropes=ropes,
+                          oil_columns=columns,
                           stages=stages, hoist=hoist, i_phi=i_phi,
                           slew_angle=None if i_phi is None else
                           (lambda t, prof=p.slew_profile: float(prof.sample(t).s)))
@@ -540,6 +562,8 @@ def initial_equilibrium(ts: TelescopicSystem, t: float = 0.0):
     :class:`~sim_core.errors.NoStaticEquilibrium` is raised, naming the angle and the lever."""
     from sim_core.errors import NoStaticEquilibrium
     try:
+        if ts.oil_columns:
+            return _oil_column_equilibrium(ts, t)
         return _initial_equilibrium(ts, t)
     except NoStaticEquilibrium as exc:
         # the statics' load continuation found a limit point below the full weight: say why
@@ -552,6 +576,27 @@ def initial_equilibrium(ts: TelescopicSystem, t: float = 0.0):
             f"cylinder's lever about the pivot D1 is {lever:.3f} m at this angle (0.714 m at "
             "60 deg) and the booms' deflection shortens it further; the limit load scales with "
             "E (docs/model.md, 'Initial state and statics')")) from exc
+
+
+def _oil_column_equilibrium(ts: TelescopicSystem, t: float):
+    """The static equilibrium of a system whose cylinders act through their oil column: that of
+    the same crane with the cylinders as constraints (the twin built without the oil column;
+    the coordinates are the same, the drive rows come on top), each column's static force F0
+    the constraint's multiplier there, so the column starts uncompressed at the commanded
+    length and the state is in equilibrium as it is.  The retraction ropes' lengths set by the
+    twin's statics are copied.  Returns (z, lambda of this system)."""
+    from dataclasses import replace
+    twin = build_telescopic(replace(ts.params, oil_column=None))
+    z, lam = _initial_equilibrium(twin, t)
+    for name, col in ts.oil_columns.items():
+        col.F0 = float(lam[twin.rows[name]][0])
+    for (e, r), (te, tr) in zip(ts.ropes, twin.ropes):
+        e.L0, r.L0 = te.L0, tr.L0
+    m = ts.model
+    if m.n_dof != twin.model.n_dof:
+        raise RuntimeError("the oil column's constrained twin has other coordinates")
+    _, lam_own = m.accelerations_and_multipliers(t, z, np.zeros_like(z))
+    return z, lam_own
 
 
 def _initial_equilibrium(ts: TelescopicSystem, t: float):
@@ -669,7 +714,8 @@ def _telescopic_result(ts: TelescopicSystem, t, ys, stats, error, scene=None):
         out["tip_acceleration"].append(J @ Qdd + (Jc @ Qd).imag / 1e-20)
         a = [lp(Q)[0] for lp in lefts]
         stroke = [np.linalg.norm(a[k + 1] - a[k]) - p.stroke0 for k in range(N - 1)]
-        forces = [lam[ts.rows[name]][0] for name in ts.drives]
+        forces = [ts.oil_columns[name].force(tk, Q, Qd) if name in ts.oil_columns
+                  else lam[ts.rows[name]][0] for name in ts.drives]
         cyl = active_stage(ts, tk) if p.mechanism == "sequential" else 0
         out["stage_stroke"].append(stroke)
         out["drive_forces"].append(forces)

@@ -143,6 +143,7 @@ class AuditedSystem:
             if self.ts.hoist is not None:       # the hoist: a rope of prescribed length
                 P["constraint_work"] += self.ts.hoist.hoist_power(Q, t)
             P["constraint_work"] += plugin_power(self.ts, t, Q, Qd)   # external loads
+            P["constraint_work"] += column_power(self.ts, t, Q, Qd)   # oil columns
         if "drive_work" in self.terms:
             P["drive_work"] = float(sum(np.sum(lam[row] * np.atleast_1d(c.target(t)[1]))
                                         for c, row in self.drives))
@@ -151,6 +152,7 @@ class AuditedSystem:
             if self.ts.i_phi is not None:
                 P["drive_work"] += slew_power(self.ts, t, Q, Qd, lam)
             P["drive_work"] += plugin_power(self.ts, t, Q, Qd)
+            P["drive_work"] += column_power(self.ts, t, Q, Qd)
         if "friction_work" in self.terms:
             P["friction_work"] = (float(Qd @ sum(mf.forces(t, Q, Qd, lam)
                                                  for mf in m.multiplier_forces))
@@ -194,6 +196,13 @@ def run_energy_audit(ts, y0: np.ndarray, t_end: float, rtol: float = 1e-6, atol:
     return out
 
 
+def column_power(ts, t: float, Q, Qd) -> float:
+    """F l' (W) of every cylinder driven through its oil column (effects.oil_column,
+    :class:`sim_core.physics.hydraulic_cylinder.OilColumn`): an applied force on the booms in
+    place of the drive's constraint, whose work it is."""
+    return float(sum(col.power(t, Q, Qd) for col in ts.oil_columns.values()))
+
+
 def _drive_power_of_outputs(ts, audit: AuditedSystem, res: Result):
     """P_drive (W) at the output times from the result's ``drive_forces`` (the drive rows'
     multipliers, in the order of ``ts.drives``) and the prescribed stage rates b'(t): the
@@ -226,7 +235,7 @@ def telescopic_energy_check(ts, res: Result) -> dict:
     audit = AuditedSystem(ts, ("drive_work",))
     n = audit.n
     E = np.array([mechanical_energy(ts, t, y[:n], y[n:2 * n]) for t, y in zip(ts_, Y)])
-    P = None if ts.i_phi is not None or ts.plugin_effects else \
+    P = None if ts.i_phi is not None or ts.plugin_effects or ts.oil_columns else \
         _drive_power_of_outputs(ts, audit, res)
     if P is None:
         P = np.array([audit.powers(t, y[:n], y[n:2 * n])[1][0] for t, y in zip(ts_, Y)])

@@ -179,6 +179,10 @@ class TelescopicParams:
     hoist_length: float = 10.0              # m, unstretched hoist rope at t = 0
     hoist_EA: float = 2e8                   # N
     hook_mass: float = 500.0                # kg
+    # the telescopic cylinder's oil column (physics.hydraulic_cylinder): None = the stage
+    # length follows the drive exactly; else {cylinder_area m^2, bulk_modulus Pa, dead_length m,
+    # damping_ratio}
+    oil_column: dict | None = None
     plugin_tables: dict = field(default_factory=dict)  # effect plug-ins on: name -> table
 
     def __post_init__(self):

@@ -62,7 +62,7 @@ E_RANGE, RHO_RANGE = dict(lo=1e8, hi=1e15), dict(lo=10.0, hi=1e5)
 TOP = Table("", (Field("kind", "choice", choices=("telescopic",)), *text_fields("telescopic")),
             tables=("solver", "booms", "boom", "luffing", "drive", "payload", "ropes",
                     "effects", "contact", "overlap", "filtering", "gravity", "luffing_drive",
-                    "slew_drive", "hoist_drive", "hoist", "model"))
+                    "slew_drive", "hoist_drive", "hoist", "oil_column", "model"))
 SOLVER = solver_fields(t_end=20.0, atol=1e-7, methods=ERROR_CONTROLLED)
 BOOMS = Table("booms", (
     Field("count", "integer", "", COMPUTED, lo=2, hi=MAX_BOOMS,
@@ -284,6 +284,10 @@ def _effects_table() -> Table:
         Field("payload_swing", "boolean", default=False,
               note="the payload and hook hang on the elastic hoist rope of [hoist] and swing; "
                    "false = a point mass fixed at the tip"),
+        Field("oil_column", "boolean", default=False,
+              note="the telescopic cylinder drives its stage through the compressible oil of "
+                   "[oil_column] (the stages can stick and slip on their sliders); false = the "
+                   "stage length follows the drive exactly (a constraint)"),
         *(Field(name, "boolean", default=False,
                 note=f"an effect plug-in ({p.validate.__module__}): {p.description}")
           for name, p in plugins.items()),
@@ -352,6 +356,17 @@ HOIST = Table("hoist", (
     Field("EA", "number", "N", 2e8, **EA_RANGE, note="axial stiffness of the hoist rope"),
     Field("hook_mass", "number", "kg", 500.0, lo=0.0, hi=1e5, note="hangs with the payload"),
 ), note="the hoist rope of effects.payload_swing")
+OIL_COLUMN = Table("oil_column", (
+    Field("cylinder_area", "number", "m^2", 0.02, lo=1e-4, hi=1.0,
+          note="piston area A"),
+    Field("bulk_modulus", "number", "Pa", 1e9, lo=1e7, hi=1e11,
+          note="effective bulk modulus beta of the oil with hoses"),
+    Field("dead_length", "number", "m", 0.5, lo=0.01, hi=10.0,
+          note="l_0: the oil in hoses and the cylinder's end as piston travel; k_h = beta A / "
+               "(l + l_0)"),
+    Field("damping_ratio", "number", "", 0.2, lo=0.0, hi=2.0,
+          note="valve and leakage losses: c_h = 2 zeta sqrt(k_h M_s), M_s the stroke mass"),
+), note="the telescopic cylinder's oil column of effects.oil_column (Merritt 1967, Sec. 5.2)")
 MODEL = Table("model", (
     Field("reduction", "choice", default="none", choices=("none", "modal"),
           note="\"none\" = full model; \"modal\" = the stroke-parametric modal ROM of "
@@ -369,7 +384,8 @@ SCHEMA = Schema(
     "telescopic", 'Telescopic scenes (`kind = "telescopic"`)',
     "sim_core.systems.telescopic.schema.validate_telescopic",
     (TOP, SOLVER, BOOMS, BOOM, SECTION, LUFFING, DRIVE, PAYLOAD, ROPES, EFFECTS, CONTACT,
-     OVERLAP, FILTERING, GRAVITY, LUFFING_DRIVE, SLEW_DRIVE, HOIST_DRIVE, HOIST, MODEL,
+     OVERLAP, FILTERING, GRAVITY, LUFFING_DRIVE, SLEW_DRIVE, HOIST_DRIVE, HOIST, OIL_COLUMN,
+     MODEL,
      *_plugin_tables()),
     rules=(
         "The stroke history keeps every boom inside its neighbour: 0 < L_s(t) < the shortest "
@@ -393,6 +409,8 @@ SCHEMA = Schema(
         "and max_accel.",
         "The slew keeps the boom's axis more than 15 deg from the lateral axis of the initial "
         "luffing plane, where the booms' Cardan angles are singular.",
+        "[oil_column] needs effects.oil_column = true, which needs flexible booms, the "
+        "synchronized drive and model.reduction = \"none\".",
         "[hoist] and [hoist_drive] need effects.payload_swing = true; a swinging payload needs "
         "a positive payload.mass + hoist.hook_mass.",
         "effects.flexible = false (the rigid limit): booms.count 2 or 3, the synchronized "
@@ -506,7 +524,7 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
                                                           k == "contact_distribution" else {}))
                      for k in ("flexible", "torsion", "gravity", "filtering", "friction",
                                "contact_distribution", "rope_elasticity", "mass_centre_offset",
-                               "payload_swing")}
+                               "payload_swing", "oil_column")}
     for name in plugins:                # effect plug-ins (sim_core.physics.plugins): off unless on
         if name in e:
             sc["effects"][name] = EFFECTS.read(e, name, "effects")
@@ -597,6 +615,22 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
         if lo < 0.1:
             raise SceneError(f"hoist_drive: the hoist rope's length drops to {lo:.4g} m (allowed: "
                              "at least 0.1 m)")
+    oc = table_of(raw, "oil_column", "")
+    OIL_COLUMN.check_keys(oc, "oil_column")
+    if oc and not eff["oil_column"]:
+        raise SceneError("[oil_column] with effects.oil_column = false: the table configures the "
+                         "oil column (allowed: effects.oil_column = true, or leave it out)")
+    if eff["oil_column"]:
+        sc["oil_column"] = {k: OIL_COLUMN.read(oc, k, "oil_column") for k in
+                            ("cylinder_area", "bulk_modulus", "dead_length", "damping_ratio")}
+        why = ("effects.flexible = false" if not eff["flexible"] else
+               "model.reduction = 'modal'" if reduction != "none" else
+               f"drive.mechanism = {sc['drive']['mechanism']!r}"
+               if sc["drive"]["mechanism"] != "synchronized" else None)
+        if why:
+            raise SceneError(f"effects.oil_column = true with {why}: the oil column drives the "
+                             "full model's synchronized stages (allowed: effects.flexible = true, "
+                             "model.reduction = 'none', drive.mechanism = 'synchronized')")
     moving = [k for k in ("luffing_drive", "slew_drive") if k in sc]
     if moving or eff["payload_swing"]:
         if not eff["flexible"] or reduction != "none":
@@ -1027,6 +1061,7 @@ def params_from_scene(sc: dict):
         **profiles, payload_swing=sc["effects"].get("payload_swing", False),
         hoist_length=hoist.get("length", 10.0), hoist_EA=hoist.get("EA", 2e8),
         hook_mass=hoist.get("hook_mass", 500.0),
+        oil_column=sc.get("oil_column") if sc["effects"].get("oil_column") else None,
         booms=booms, overlaps=overlaps, luffing=luffing,
         n_booms=b["count"], boom_length=b.get("length", booms[0].length if booms else 10.0),
         luffing_angle_deg=b["luffing_angle_deg"],

@@ -47,7 +47,7 @@ ACTUATOR_TABLES = {"telescopic": "drive", "luffing": "luffing_drive", "slew": "s
 #: outputs of :meth:`TelescopicStepper.outputs` that need neither the multipliers nor the
 #: contact solution (``outputs(names)`` with only these skips the rest)
 LIGHT_OUTPUTS = ("time", "actuators", "tip_position", "tip_velocity", "payload_position",
-                 "payload_velocity", "sway_angle", "sway_rate")
+                 "payload_velocity", "sway_angle", "sway_rate", "telescopic_stroke")
 
 
 def stepper_for(scene: dict):
@@ -165,6 +165,8 @@ class TelescopicStepper:
         for c in m.nonlinear:
             if c.name in ts.drives:
                 c.target = _length_of(tel)
+        for col in ts.oil_columns.values():          # the piston the oil column follows
+            col.command = _length_of(tel)
         luff = Drive(p.luffing_profile or HoldProfile(s0=math.radians(p.luffing_angle_deg)),
                      self.clock)
         self.drives["luffing"] = luff
@@ -240,10 +242,24 @@ class TelescopicStepper:
         finally:
             self.clock[0] = clock
         out["tip_position"], out["tip_velocity"] = r, v
+        if "telescopic_stroke" in names:
+            out["telescopic_stroke"] = self._stroke(Q, Qd)
         out["time"] = self.t
         if "actuators" in names:
             out["actuators"] = self._actuators()
         return {k: out[k] for k in names}
+
+    def _stroke(self, Q, Qd) -> np.ndarray:
+        """(L_s, L_s'): the first cylinder's stage length, m (the distance of boom 2's left
+        section from boom 1's, the drive's piston length where the stage follows it exactly)
+        and its rate, m/s; with the oil column the stage lags the commanded piston (the
+        ``actuators`` output)."""
+        from sim_core.physics.constraints import material_point
+        from sim_core.physics.point_effects import path_length
+        m = self.ts.model
+        ell, grad = path_length((material_point(m, 1, s_fixed=0.0),
+                                 material_point(m, 0, s_fixed=0.0)), Q)
+        return np.array([float(np.real(ell)), float(np.real(grad) @ np.real(Qd))])
 
     def _sway(self, Q, Qd, r_tip, v_tip) -> dict:
         """payload_position, payload_velocity (m, m/s), sway_angle (rad: from the vertical in the
