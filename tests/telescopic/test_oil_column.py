@@ -52,6 +52,10 @@ def test_the_column_starts_in_the_constrained_equilibrium_at_rest():
         out = sim.outputs()
         assert np.max(np.abs(out["tip_position"] - tip0)) < 1e-9
         forces[oil] = float(out["telescopic_cylinder_force"])
+        # the stages' stroke: in the full outputs as in the light ones, at the drive's length
+        assert np.array_equal(out["telescopic_stroke"],
+                              sim.outputs(["telescopic_stroke"])["telescopic_stroke"])
+        assert out["telescopic_stroke"][0] == pytest.approx(2.0, abs=1e-9)
         if oil:
             F0 = sim.system.oil_columns["telescopic_cylinder"].F0
     assert forces[True] == pytest.approx(forces[False], rel=1e-9)

@@ -211,8 +211,9 @@ class TelescopicStepper:
         try:
             res = _telescopic_result(self.ts, np.array([0.0]), [self.y], {}, None, self.scene)
             out = {k: np.asarray(res[k])[0] for k in res.keys() if k != "state"}
-            out.update(self._light(("payload_velocity", "sway_rate")
-                                   if self.ts.hoist is not None else ()))
+            out.update(self._light((("payload_velocity", "sway_rate")
+                                    if self.ts.hoist is not None else ())
+                                   + ("telescopic_stroke",)))
         finally:
             self.clock[0] = clock
         out["time"] = self.t
