@@ -69,8 +69,8 @@ class FullPhysicsPlant:
     ``booms``: 3 or 5; ``fidelity``: "paper" or "converged" (``FIDELITIES``); ``payload`` kg
     (default 25 t for 3 booms, 10 t for 5) and ``angle_deg`` (luffing angle, deg) within the
     modal tables' ranges; ``stroke0``: the piston length L_s at the start (m, at rest in static
-    equilibrium); ``friction``: the sliders' Coulomb friction (Section 8; ``mu`` = (static,
-    dynamic) coefficients, default the scene's 0.15, 0.1); ``oil_column``: the telescopic
+    equilibrium); ``friction``: the sliders' Coulomb friction (Section 8; ``mu_static``,
+    ``mu_dynamic``: its coefficients, None the scene's 0.15, 0.1); ``oil_column``: the telescopic
     cylinder drives the stages through its oil column (``effects.oil_column``; ``hydraulics``:
     the ``[oil_column]`` table's cylinder_area, bulk_modulus, dead_length, damping_ratio, default
     the scene's), so that the commanded stroke is the piston's and the stages lag it, sticking
@@ -82,7 +82,8 @@ class FullPhysicsPlant:
                  angle_deg: float = 60.0, stroke0: float = 2.0, friction: bool = True,
                  payload_swing: bool = False, rope_length: float | None = None,
                  n_nodes: int | None = None, oil_column: bool = False,
-                 hydraulics: dict | None = None, mu: tuple[float, float] | None = None):
+                 hydraulics: dict | None = None, mu_static: float | None = None,
+                 mu_dynamic: float | None = None):
         if fidelity not in FIDELITIES:
             raise ValueError(f"fidelity = {fidelity!r}: allowed {', '.join(map(repr, FIDELITIES))}")
         if isinstance(booms, bool) or booms not in SCENES:
@@ -116,8 +117,9 @@ class FullPhysicsPlant:
         if oil_column:
             overrides["effects.oil_column"] = True
             overrides.update({f"oil_column.{k}": float(v) for k, v in (hydraulics or {}).items()})
-        if mu is not None:
-            overrides["contact.mu_static"], overrides["contact.mu_dynamic"] = map(float, mu)
+        for name, mu in (("mu_static", mu_static), ("mu_dynamic", mu_dynamic)):
+            if mu is not None:
+                overrides[f"contact.{name}"] = float(mu)
         self.booms, self.fidelity, self.payload_swing = booms, fidelity, bool(payload_swing)
         self.oil_column = bool(oil_column)
         self.scene = load_scene(SCENES[booms], overrides=overrides)

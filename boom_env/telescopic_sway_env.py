@@ -57,9 +57,9 @@ Fidelity (``fidelity``)
   coefficients as the ROM's stroke friction) against its own slider friction (Section 8), so
   its stages stick and slip behind the piston as the ROM's do; the observed L_s, its rate and
   the applied acceleration are then its stages' (``info["stuck"]``: their rate within the
-  friction law's stick band, |L_s'| < 0.01 m/s).  ``friction=False``: the stages follow the
-  piston exactly.  The scalar env only; slow (a few env steps per second): for checking
-  policies.
+  friction law's stick band, |L_s'| < v_eps = 0.01 m/s).  ``friction=False``: the stages
+  follow the piston exactly.  The scalar env only; slow (a few env steps per second): for
+  checking policies.
 
 Action space
 ------------
@@ -312,7 +312,7 @@ class SwayTask:
         self._plant_kw = {}
         if self.full and self.friction:
             self._plant_kw = dict(
-                oil_column=True, mu=(fr.get("mu_static", 0.15), fr.get("mu_dynamic", 0.1)),
+                oil_column=True, mu_static=fr.get("mu_static"), mu_dynamic=fr.get("mu_dynamic"),
                 hydraulics=dict(cylinder_area=fr["cylinder_area"],
                                 bulk_modulus=fr["bulk_modulus"], dead_length=fr["dead_length"],
                                 damping_ratio=fr["hydraulic_damping"]))
@@ -523,8 +523,9 @@ class SwayTask:
         rom = self.rom
         L, v = self._stroke()
         # stuck: the ROM's stick state, or the full model's stages within its friction law's
-        # stick band |L_s'| < v_eps (0.01 m/s, the scene's)
-        stuck = np.abs(v) < 0.01 if self._plant_kw else rom.stuck
+        # stick band |L_s'| < v_eps (the plant scene's contact.v_eps)
+        stuck = (np.abs(v) < self.plant.scene["contact"]["v_eps"] if self._plant_kw
+                 else rom.stuck)
         return {"time": self.t.copy(), "stroke": np.array(L), "stroke_rate": np.array(v),
                 "velocity_saturated": self.sat.copy(),
                 "end_stop": self.stop.copy(), "tip_deflection": self.defl[:, :2].copy(),

@@ -587,14 +587,14 @@ def _oil_column_equilibrium(ts: TelescopicSystem, t: float):
     twin's statics are copied.  Returns (z, lambda of this system)."""
     from dataclasses import replace
     twin = build_telescopic(replace(ts.params, oil_column=None))
+    m = ts.model
+    if m.n_dof != twin.model.n_dof:
+        raise RuntimeError("the oil column's constrained twin has other coordinates")
     z, lam = _initial_equilibrium(twin, t)
     for name, col in ts.oil_columns.items():
         col.F0 = float(lam[twin.rows[name]][0])
     for (e, r), (te, tr) in zip(ts.ropes, twin.ropes):
         e.L0, r.L0 = te.L0, tr.L0
-    m = ts.model
-    if m.n_dof != twin.model.n_dof:
-        raise RuntimeError("the oil column's constrained twin has other coordinates")
     _, lam_own = m.accelerations_and_multipliers(t, z, np.zeros_like(z))
     return z, lam_own
 

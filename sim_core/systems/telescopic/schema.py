@@ -1061,7 +1061,7 @@ def params_from_scene(sc: dict):
         **profiles, payload_swing=sc["effects"].get("payload_swing", False),
         hoist_length=hoist.get("length", 10.0), hoist_EA=hoist.get("EA", 2e8),
         hook_mass=hoist.get("hook_mass", 500.0),
-        oil_column=sc.get("oil_column") if sc["effects"].get("oil_column") else None,
+        oil_column=sc.get("oil_column"),
         booms=booms, overlaps=overlaps, luffing=luffing,
         n_booms=b["count"], boom_length=b.get("length", booms[0].length if booms else 10.0),
         luffing_angle_deg=b["luffing_angle_deg"],
