@@ -38,7 +38,12 @@ mu_static N / k_h: 6 mm at L_s = 2 m, 5 cm at 8 m) and lurches forward when the 
 mu_dynamic N: stick-slip.  Hydraulic parameters (constructor arguments): ``cylinder_area``
 0.02 m^2, ``bulk_modulus`` 1e9 Pa, ``dead_length`` 0.5 m, ``hydraulic_damping`` 0.2;
 ``mu_static``, ``mu_dynamic``.  ``friction=False``: the stages follow the piston exactly (v0's
-kinematics).
+kinematics).  ``friction_law``: ``"coulomb"`` (default) the stick and slip above;
+``"regularised"`` the full model's own law (a damper mu_static N / v_eps below v_eps =
+0.01 m/s, the cubic blend to mu_dynamic up to 2 v_eps): a stage whose column force stays below
+breakaway creeps after the piston with the time constant (mu_static N / v_eps) / k_h, 0.6-5 s
+over the stroke at 25 t, instead of standing still (``info["stuck"]`` then means |L_s'| <
+v_eps, as on the full model).  The full-model fidelities always use the regularised law.
 
 Stroke kinematics of the piston as v0: the action is held for ``dt`` (piecewise-constant
 acceleration), exact integration with velocity saturation |v| <= v_max
@@ -171,6 +176,7 @@ Version history
   "converged" (full model, scalar env); render exaggeration 20x.  The full-model fidelities
   with friction drive the stages through the cylinder's oil column, as the ROM does (before,
   the full model's stages followed the piston exactly while the ROM's stuck and slipped).
+  Option ``friction_law="regularised"`` (the default ``"coulomb"`` unchanged).
 * v0: ``boom_env.telescopic_env`` (payload fixed at the tip; its own version history).
 """
 
@@ -182,7 +188,8 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from sim_core.vector_rom import ROPE_RANGE, SWAY_LIMIT, TABLE_BOOMS, VectorROM, allowed_ranges
+from sim_core.vector_rom import (FRICTION_LAWS, ROPE_RANGE, SWAY_LIMIT, TABLE_BOOMS, VectorROM,
+                                 allowed_ranges)
 
 from . import _sway_kernel as kernel
 from ._checks import flag as _flag
@@ -230,7 +237,8 @@ class SwayTask:
                  sway_rate_ref=None, sway_limit: float = SWAY_LIMIT, friction: bool = True,
                  mu_static=None, mu_dynamic=None, cylinder_area: float = 0.02,
                  bulk_modulus: float = 1.0e9, dead_length: float = 0.5,
-                 hydraulic_damping: float = 0.2, max_episode_steps=None):
+                 hydraulic_damping: float = 0.2, friction_law: str = "coulomb",
+                 max_episode_steps=None):
         if not isinstance(task, str) or task not in ("extraction", "retraction"):
             raise ValueError(f"task = {task!r}: allowed 'extraction', 'retraction'")
         if not isinstance(fidelity, str) or fidelity not in FIDELITIES:
@@ -305,6 +313,10 @@ class SwayTask:
                       bulk_modulus=_positive("bulk_modulus", bulk_modulus, 1e11),
                       dead_length=_positive("dead_length", dead_length, 100.0),
                       hydraulic_damping=_positive("hydraulic_damping", hydraulic_damping, 0.99))
+        if not isinstance(friction_law, str) or friction_law not in FRICTION_LAWS:
+            raise ValueError(f"friction_law = {friction_law!r}: allowed "
+                             + ", ".join(map(repr, FRICTION_LAWS)))
+        self.friction_law = friction_law
         self.full = fidelity != "rl"
         self.plant = None
         # the full model with friction drives its stages through the oil column of the same
@@ -322,7 +334,8 @@ class SwayTask:
         rom_friction = self.friction and not self.full
         self.rom = VectorROM(self.n, booms=self.booms, n_modes=self.n_modes, payload_swing=True,
                              dt=self.dt, v_max=self.v_max, stroke_limits=(self.L_min, self.L_max),
-                             friction=rom_friction, **(fr if rom_friction else {}))
+                             friction=rom_friction,
+                             **(dict(fr, friction_law=friction_law) if rom_friction else {}))
         self.rate_max = 2.0 * self.sway_limit * math.sqrt(G / ROPE_RANGE[0])
         low = [self.L_min, -self.v_max, -self.a_max, self.L_min, 0.0, -1.0, -1.0, -10.0, -10.0,
                -self.sway_limit, -self.sway_limit, -self.rate_max, -self.rate_max]

@@ -32,6 +32,7 @@ from sim_core.systems.telescopic.modal_batch import (
     REFINE,
     ROPE_RANGE,
     SWAY_LIMIT,
+    V_EPS,
     BatchROM,
     coupled_tables,
     coupled_tables_of,
@@ -44,8 +45,12 @@ from sim_core.systems.telescopic.modal_batch import (
     stroke_segments,
 )
 
-__all__ = ["VectorROM", "ROPE_RANGE", "SWAY_LIMIT", "TABLE_BOOMS", "allowed_ranges",
-           "luffing_frame", "stroke_segments"]
+#: the stroke friction's laws (VectorROM friction_law): Coulomb stick and slip, or the full
+#: model's regularised law
+FRICTION_LAWS = ("coulomb", "regularised")
+
+__all__ = ["VectorROM", "FRICTION_LAWS", "ROPE_RANGE", "SWAY_LIMIT", "TABLE_BOOMS",
+           "allowed_ranges", "luffing_frame", "stroke_segments"]
 
 
 def luffing_frame(luffing_angle_deg: float):
@@ -86,7 +91,10 @@ class VectorROM:
     (stiffness bulk_modulus * cylinder_area / (L_s + dead_length) N/m, damping ratio
     hydraulic_damping of the stroke mode) against mu N, N the sliders' total normal load of the
     full model's static equilibria (``friction_table``); mu_static, mu_dynamic default to the
-    scene defaults (0.15, 0.1).
+    scene defaults (0.15, 0.1).  ``friction_law``: ``"coulomb"`` (default) the stages stick
+    until the column's force reaches mu_static N; ``"regularised"`` the full model's law (a
+    damper mu_static N / v_eps below ``v_eps`` m/s, default the scene's 0.01, so held stages
+    creep; modal_batch, Regularised stroke friction).
 
     State arrays (read them, or use :meth:`save_state`): ``stroke`` (N,) m, ``stroke_rate``
     (N,) m/s, ``q``, ``qd`` (N, n_c) modal coordinates."""
@@ -96,7 +104,8 @@ class VectorROM:
                  use_compiled: bool = True, friction: bool = False,
                  cylinder_area: float = CYLINDER_AREA, bulk_modulus: float = BULK_MODULUS,
                  dead_length: float = DEAD_LENGTH, hydraulic_damping: float = HYDRAULIC_DAMPING,
-                 mu_static: float | None = None, mu_dynamic: float | None = None):
+                 mu_static: float | None = None, mu_dynamic: float | None = None,
+                 friction_law: str = "coulomb", v_eps: float = V_EPS):
         if isinstance(n_envs, bool) or not isinstance(n_envs, (int, np.integer)) or n_envs < 1:
             raise ValueError(f"n_envs = {n_envs!r}: must be an integer >= 1")
         if isinstance(booms, bool) or booms not in TABLE_BOOMS:
@@ -152,7 +161,14 @@ class VectorROM:
             if mu_k > mu_s:
                 raise ValueError(f"mu_dynamic = {mu_k!r} > mu_static = {mu_s!r}: allowed "
                                  "mu_dynamic <= mu_static")
-            fr = {"kA": _finite_positive("bulk_modulus", bulk_modulus)
+            if not isinstance(friction_law, str) or friction_law not in FRICTION_LAWS:
+                raise ValueError(f"friction_law = {friction_law!r}: allowed "
+                                 + ", ".join(map(repr, FRICTION_LAWS)))
+            v_eps = _finite_positive("v_eps", v_eps)
+            if v_eps > 0.1:
+                raise ValueError(f"v_eps = {v_eps!r}: allowed (0, 0.1] m/s")
+            fr = {"law": friction_law, "v_eps": float(v_eps),
+                  "kA": _finite_positive("bulk_modulus", bulk_modulus)
                   * _finite_positive("cylinder_area", cylinder_area),
                   "l0": _finite_positive("dead_length", dead_length),
                   "zeta_h": float(hydraulic_damping), "mu_static": float(mu_s),
@@ -343,7 +359,9 @@ class VectorROM:
 
     @property
     def stuck(self) -> np.ndarray:
-        """Whether each crane's stages stick (friction on; all False without friction)."""
+        """Whether each crane's stages stick (friction on; all False without friction); with
+        friction_law "regularised": whether their rate is within the stick band, |L_s'| <
+        v_eps (as the full model's)."""
         b = self._b
         return b.stuck.copy() if self.friction is not None else np.zeros(self.n_envs, bool)
 

@@ -53,6 +53,7 @@ V1_ONLY = {
     "mu_static": number(0.0, 0.3), "mu_dynamic": number(0.0, 0.1),
     "cylinder_area": number(1e-3, 0.1), "hydraulic_damping": number(0.05, 0.9),
     "sway_ref": number(1e-3, 0.1), "w_sway": number(0, 10),
+    "friction_law": st.one_of(st.sampled_from(["coulomb", "regularised"]), junk),
 }
 V0_ONLY = {"payload": number(20e3, 30e3), "payload_range": pair(20e3, 30e3)}
 

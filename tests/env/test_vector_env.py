@@ -47,12 +47,14 @@ def test_make_vec_gives_the_native_vector_env(env_id):
     v.close()
 
 
-@pytest.mark.parametrize("env_id", IDS)
-def test_native_equals_sync_vector_env_of_the_scalar_env_across_autoresets(env_id):
+@pytest.mark.parametrize("env_id, law", [(i, "coulomb") for i in IDS]
+                         + [(IDS[0], "regularised")])
+def test_native_equals_sync_vector_env_of_the_scalar_env_across_autoresets(env_id, law):
     """Per-env payload, angle and rope length (drawn per sub-env), random actions, episodes of
     20 steps (t_max = 1 s) so that every sub-env resets several times: observations, rewards,
-    flags and infos are the same numbers as a SyncVectorEnv of the scalar env."""
-    n, kw = 5, dict(RANDOM, t_max=1.0)
+    flags and infos are the same numbers as a SyncVectorEnv of the scalar env (with either
+    friction law)."""
+    n, kw = 5, dict(RANDOM, t_max=1.0, friction_law=law)
     native = gym.make_vec(env_id, num_envs=n, vectorization_mode="vector_entry_point", **kw)
     sync = gym.make_vec(env_id, num_envs=n, vectorization_mode="sync", **kw)
     assert isinstance(sync, SyncVectorEnv)

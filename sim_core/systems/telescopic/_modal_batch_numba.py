@@ -395,31 +395,34 @@ def _stage_piece(dyn, grid, ntab, k, xc, vc, ae, e, ed, stuck, sdir, tmax, Ms, k
 
 
 def step_all_friction(xc, vc, e, ed, stuck, sdir, q, qd, a, dyn, ntab, grid, dt, vmax, Lmin,
-                      Lmax, Ms, kA, l0, zh, mus, muk, sat, stop, acc, wf):
+                      Lmax, Ms, kA, l0, zh, mus, muk, veps, hmax, sat, stop, acc, wf):
     """BatchROM.step with stroke friction: the commanded piston (xc, vc) follows the stroke
     kinematics of step_all (saturation, end stops); the stage lags it by e on the oil column and
-    sticks or slips on the sliders (modal_batch module docstring, Stroke friction).  Arrays
-    advanced in place; acc is the stage's mean acceleration, wf accumulates the friction
-    work (J)."""
+    sticks or slips on the sliders (modal_batch module docstring, Stroke friction), or, with
+    hmax > 0, follows the full model's regularised law with stick band veps in trapezoidal
+    steps of at most hmax (Regularised stroke friction).  Arrays advanced in place; acc is the
+    stage's mean acceleration, wf accumulates the friction work (J)."""
     for k in range(xc.shape[0]):
         _step_friction_one(k, xc, vc, e, ed, stuck, sdir, q, qd, a, dyn, ntab, grid, dt, vmax,
-                           Lmin, Lmax, Ms, kA, l0, zh, mus, muk, sat, stop, acc, wf)
+                           Lmin, Lmax, Ms, kA, l0, zh, mus, muk, veps, hmax, sat, stop, acc,
+                           wf)
 
 
 def step_all_friction_out(xc, vc, e, ed, stuck, sdir, q, qd, a, dyn, ntab, grid, dt, vmax,
-                          Lmin, Lmax, Ms, kA, l0, zh, mus, muk, sat, stop, acc, wf, out, defl,
-                          sway):
+                          Lmin, Lmax, Ms, kA, l0, zh, mus, muk, veps, hmax, sat, stop, acc, wf,
+                          out, defl, sway):
     """step_all_friction and then outputs_all at the stage strokes xc + e in one pass over the
     cranes (each crane's tables are read while they are in cache): the same arithmetic as the
     two calls."""
     for k in range(xc.shape[0]):
         _step_friction_one(k, xc, vc, e, ed, stuck, sdir, q, qd, a, dyn, ntab, grid, dt, vmax,
-                           Lmin, Lmax, Ms, kA, l0, zh, mus, muk, sat, stop, acc, wf)
+                           Lmin, Lmax, Ms, kA, l0, zh, mus, muk, veps, hmax, sat, stop, acc,
+                           wf)
         _outputs_one(k, xc[k] + e[k], q, qd, out, grid, defl, sway, k)
 
 
 def _step_friction_one(k, xc, vc, e, ed, stuck, sdir, q, qd, a, dyn, ntab, grid, dt, vmax,
-                       Lmin, Lmax, Ms, kA, l0, zh, mus, muk, sat, stop, acc, wf):
+                       Lmin, Lmax, Ms, kA, l0, zh, mus, muk, veps, hmax, sat, stop, acc, wf):
     """step_all_friction for crane k."""
     Lk, vk, ak = xc[k], vc[k], a[k]
     ek, edk, st, sd = e[k], ed[k], stuck[k], sdir[k]
@@ -434,20 +437,30 @@ def _step_friction_one(k, xc, vc, e, ed, stuck, sdir, q, qd, a, dyn, ntab, grid,
                                                            Lmax)
         s_sat = s_sat or sat_k
         s_stop = s_stop or stop_k
-        # the stage within this commanded segment, piece by piece
-        t_seg = 0.0
-        for _p in range(64):
-            rem = tau - t_seg
-            if rem <= 1e-13:
-                break
-            piece, Lk, vk, ek, edk, st, sd = _stage_piece(
-                dyn, grid, ntab, k, Lk, vk, ae, ek, edk, st, sd, rem, Ms[k], kA, l0, zh,
-                mus, muk, q, qd, wf)
-            t_seg += piece
-        if t_seg < tau - 1e-13:                   # pathological: finish kinematically
-            r = tau - t_seg
-            Lk = Lk + vk * r + 0.5 * ae * r * r
-            vk = vk + ae * r
+        if hmax > 0.0:
+            # the regularised law: trapezoidal steps of at most hmax over the segment
+            n = max(1, int(math.ceil(tau / hmax - 1e-9)))
+            h = tau / n
+            for _j in range(n):
+                ek, edk = _creep_substep(dyn, grid, ntab, k, Lk, vk, ae, ek, edk, h, Ms[k], kA,
+                                         l0, zh, mus, muk, veps, q, qd, wf)
+                Lk = Lk + vk * h + 0.5 * ae * h * h
+                vk = vk + ae * h
+        else:
+            # Coulomb: the stage within this commanded segment, piece by piece
+            t_seg = 0.0
+            for _p in range(64):
+                rem = tau - t_seg
+                if rem <= 1e-13:
+                    break
+                piece, Lk, vk, ek, edk, st, sd = _stage_piece(
+                    dyn, grid, ntab, k, Lk, vk, ae, ek, edk, st, sd, rem, Ms[k], kA, l0, zh,
+                    mus, muk, q, qd, wf)
+                t_seg += piece
+            if t_seg < tau - 1e-13:                   # pathological: finish kinematically
+                r = tau - t_seg
+                Lk = Lk + vk * r + 0.5 * ae * r * r
+                vk = vk + ae * r
         if tau == t_s and tau < t_left + 1e-15:
             Lk = min(max(Lk, Lmin), Lmax)
             edk += vk                              # the piston stops; the stage does not
@@ -464,11 +477,72 @@ def _step_friction_one(k, xc, vc, e, ed, stuck, sdir, q, qd, a, dyn, ntab, grid,
     vc[k] = vk
     e[k] = ek
     ed[k] = edk
+    if hmax > 0.0:
+        st = abs(vk + edk) < veps
     stuck[k] = st
     sdir[k] = sd
     sat[k] = s_sat
     stop[k] = s_stop
     acc[k] = (vk + edk - v_start) / dt
+
+
+def _mu_regularised(v, mus, muk, veps):
+    """(mu(v), d mu / dv) of the full model's regularised friction law
+    (sim_core.physics.contact.sliding_block_contact.FrictionLaw): mu_s v / v_eps below v_eps,
+    the cubic blend to mu_k up to 2 v_eps, mu_k sign(v) beyond."""
+    a = abs(v)
+    if a <= veps:
+        return mus * v / veps, mus / veps
+    t = a / veps - 1.0
+    if t >= 1.0:
+        return math.copysign(muk, v), 0.0
+    return (math.copysign(mus + (muk - mus) * t * t * (3.0 - 2.0 * t), v),
+            (muk - mus) * 6.0 * t * (1.0 - t) / veps)
+
+
+def _creep_substep(dyn, grid, ntab, k, xc, vc, ae, e, ed, h, Ms, kA, l0, zh, mus, muk, veps,
+                   q, qd, wf):
+    """One trapezoidal step h of crane k's stage lag e under the regularised law (modal_batch
+    module docstring, Regularised stroke friction): M e'' = -M ae - k_h e - c_h e' - N mu(v),
+    v = vc + e', k_h, c_h and N frozen at the step's start; the modes driven at the stage's
+    mean acceleration over the step.  Returns (e1, ed1)."""
+    L0 = xc + e
+    i, w = _interval(grid, L0)
+    Nn = (1 - w) * ntab[k, i] + w * ntab[k, i + 1]
+    kh = kA / (L0 + l0)
+    ch = 2.0 * zh * math.sqrt(kh * Ms)
+    v0 = vc + ed
+    vc1 = vc + ae * h
+    mu0 = _mu_regularised(v0, mus, muk, veps)[0]
+    # R(x) = g x + r0 + N mu(vc1 + x) / 2 = 0 for x = ed1: g > N max|mu'| / 2 for the steps
+    # used (M / h alone is ~1e7 N s/m), so R increases; mu is bounded by mus, which brackets
+    # the root; Newton within the bracket, bisection where it leaves it
+    g = Ms / h + 0.25 * kh * h + 0.5 * ch
+    r0 = -Ms * ed / h + Ms * ae + kh * (e + 0.25 * h * ed) + 0.5 * ch * ed + 0.5 * Nn * mu0
+    lo = (-r0 - 0.5 * Nn * mus) / g
+    hi = (-r0 + 0.5 * Nn * mus) / g
+    x = min(max(ed, lo), hi)
+    for _ in range(60):
+        mu1, dmu1 = _mu_regularised(vc1 + x, mus, muk, veps)
+        R = g * x + r0 + 0.5 * Nn * mu1
+        if R > 0.0:
+            hi = x
+        else:
+            lo = x
+        dR = g + 0.5 * Nn * dmu1
+        xn = x - R / dR
+        if not (lo < xn < hi):
+            xn = 0.5 * (lo + hi)
+        if abs(xn - x) <= 1e-15 * (1.0 + abs(x)) or hi - lo <= 1e-15 * (1.0 + abs(x)):
+            x = xn
+            break
+        x = xn
+    ed1 = x
+    e1 = e + 0.5 * h * (ed + ed1)
+    v1 = vc1 + ed1
+    _advance(dyn, grid, k, L0, v0, (v1 - v0) / h, h, q, qd)
+    wf[k] += 0.5 * h * Nn * (mu0 * v0 + _mu_regularised(v1, mus, muk, veps)[0] * v1)
+    return e1, ed1
 
 
 def outputs_all(L, q, qd, out, grid, defl, sway):
@@ -790,6 +864,8 @@ if AVAILABLE:
     outputs_sel = _jit(outputs_sel)
     step_all_out = _jit(step_all_out)
     step_all_friction_out = _jit(step_all_friction_out)
+    _mu_regularised = _jit(_mu_regularised)
+    _creep_substep = _jit(_creep_substep)
     coupled_modes = _jit(coupled_modes)
     _lerp1 = _jit(_lerp1)
     _bilinear = _jit(_bilinear)

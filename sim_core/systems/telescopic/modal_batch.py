@@ -117,7 +117,30 @@ along its chord over the piece.  Left out: the modes' inertia reaction on the st
 (Gamma^T q'', one-way coupling: the stroke drives the modes), the friction's own modal load
 (the sliders' friction forces act inside the booms), the variation of the normal load with the
 dynamic contact forces (it is the static one), and the regularisation of the full model's
-friction law (v_eps: this is the law's sticking limit).
+friction law (v_eps: this is the law's sticking limit; ``law = "regularised"`` below keeps it).
+
+Regularised stroke friction (``law = "regularised"``)
+------------------------------------------------------
+The full model's own law instead of Coulomb stick (sim_core.physics.contact.
+sliding_block_contact.FrictionLaw, paper Eq. 65 regularised with the switching speed v_eps):
+mu(v) = mu_s v / v_eps for |v| <= v_eps, a cubic blend to mu_k up to 2 v_eps, mu_k sign(v)
+beyond.  Below v_eps the law is a damper mu_s N / v_eps, so a stage whose column force stays
+below breakaway creeps after the piston (overdamped, time constant (mu_s N / v_eps) / k_h:
+0.6-5 s over the stroke for three booms at 25 t, 60 deg) instead of standing still.  The lag
+obeys
+
+    M_s e'' = -M_s x_c'' - k_h e - c_h e' - N mu(x_c' + e')
+
+integrated by the trapezoidal rule in steps of at most CREEP_STEP within every piece of
+constant piston acceleration, k_h, c_h and N frozen at each step's start.  The step's implicit
+equation for e' is R(x) = g x + r0 + N mu(x_c'(t + h) + x) / 2 = 0 with g = M_s / h + k_h h / 4
++ c_h / 2; |mu| <= mu_s brackets a root, found by Newton within the bracket (bisection where
+a Newton step leaves it).  At the scene's coefficients g exceeds N max|mu'| / 2 (the falling
+branch, 1.5 (mu_s - mu_k) N / v_eps) for h <= 5 ms, so R increases and the root is unique.  The
+modes are driven by the stage's mean acceleration over each step (ModalROM.advance's exact
+step).  Trapezoidal, with the law's kink at v_eps: between first and second order in the step
+(tests/env/test_v1_friction.py).  ``stuck`` then means |L_s'| < v_eps, the full model's stick
+band.
 """
 
 from __future__ import annotations
@@ -133,6 +156,8 @@ CYLINDER_AREA = 0.02             # m^2, piston area (bore 160 mm)
 BULK_MODULUS = 1.0e9             # Pa, effective oil bulk modulus (oil with hoses)
 DEAD_LENGTH = 0.5                # m, oil column at L_s = 0 (dead volume / area)
 HYDRAULIC_DAMPING = 0.2          # damping ratio of the stroke mode
+V_EPS = 0.01                     # m/s, the full model's stick band (scene default contact.v_eps)
+CREEP_STEP = 0.005               # s, the regularised law's trapezoidal step (module docstring)
 SWAY_LIMIT = 0.3                 # rad, small-angle range (module docstring)
 ROPE_RANGE = (1.0, 10.0)         # m, hoist-rope lengths accepted (tests/env/test_v1_sway.py)
 REFINE = 4                       # refinement of the L_s grid for the coupled tables
@@ -485,7 +510,8 @@ class BatchROM:
                  L_min: float, L_max: float, use_compiled: bool = True, friction=None):
         self.compiled = bool(use_compiled and compiled.AVAILABLE)
         # stroke friction (module docstring): None, or dict of kA (N: bulk modulus times
-        # piston area), l0 (m, dead oil length), zeta_h, mu_static, mu_dynamic
+        # piston area), l0 (m, dead oil length), zeta_h, mu_static, mu_dynamic; with
+        # law = "regularised" also v_eps (m/s)
         self.friction = friction
         if friction is not None:
             self.e = np.zeros(n_envs)             # stage lag behind the piston, m
@@ -522,6 +548,12 @@ class BatchROM:
         i = np.minimum(np.searchsorted(g, Lc, side="right") - 1, len(g) - 2)
         w = ((Lc - g[i]) / (g[i + 1] - g[i]))[:, None, None]
         return (1 - w) * tab[ids, i] + w * tab[ids, i + 1]
+
+    def _law(self) -> tuple[float, float]:
+        """(v_eps m/s, step s) of the kernels' friction law: (0, 0) Coulomb stick and slip,
+        (v_eps, CREEP_STEP) the full model's regularised law (module docstring)."""
+        f = self.friction
+        return (f["v_eps"], CREEP_STEP) if f.get("law") == "regularised" else (0.0, 0.0)
 
     # -- exact modal step ----------------------------------------------------------------
     def _advance(self, ids, a, tau):
@@ -567,7 +599,7 @@ class BatchROM:
                                        self.q, self.qd, a, self.dyn, self.ntab, self.grid,
                                        self.dt, self.v_max, self.L_min, self.L_max, self.Ms,
                                        f["kA"], f["l0"], f["zeta_h"], f["mu_static"],
-                                       f["mu_dynamic"], sat, stop, acc, self.wf)
+                                       f["mu_dynamic"], *self._law(), sat, stop, acc, self.wf)
             return sat, stop, acc
         if self.compiled:
             sat = np.empty(n, bool)
@@ -648,8 +680,8 @@ class BatchROM:
             compiled.step_all_friction_out(
                 self.L, self.v, self.e, self.ed, self.stuck, self.sdir, self.q, self.qd, a,
                 self.dyn, self.ntab, self.grid, self.dt, self.v_max, self.L_min, self.L_max,
-                self.Ms, f["kA"], f["l0"], f["zeta_h"], f["mu_static"], f["mu_dynamic"], sat,
-                stop, acc, self.wf, self.out, defl, sway)
+                self.Ms, f["kA"], f["l0"], f["zeta_h"], f["mu_static"], f["mu_dynamic"],
+                *self._law(), sat, stop, acc, self.wf, self.out, defl, sway)
         else:
             compiled.step_all_out(self.L, self.v, self.q, self.qd, a, self.dyn, self.grid,
                                   self.dt, self.v_max, self.L_min, self.L_max, sat, stop, acc,
