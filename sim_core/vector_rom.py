@@ -148,6 +148,12 @@ class VectorROM:
         fr = None
         if friction not in (True, False):
             raise ValueError(f"friction = {friction!r}: allowed True, False")
+        if not isinstance(friction_law, str) or friction_law not in FRICTION_LAWS:
+            raise ValueError(f"friction_law = {friction_law!r}: allowed "
+                             + ", ".join(map(repr, FRICTION_LAWS)))
+        v_eps = _finite_positive("v_eps", v_eps)
+        if v_eps > 0.1:
+            raise ValueError(f"v_eps = {v_eps!r}: allowed (0, 0.1] m/s")
         if friction:
             from sim_core.systems.telescopic.friction_table import load
             tab = load(self.booms)
@@ -161,12 +167,6 @@ class VectorROM:
             if mu_k > mu_s:
                 raise ValueError(f"mu_dynamic = {mu_k!r} > mu_static = {mu_s!r}: allowed "
                                  "mu_dynamic <= mu_static")
-            if not isinstance(friction_law, str) or friction_law not in FRICTION_LAWS:
-                raise ValueError(f"friction_law = {friction_law!r}: allowed "
-                                 + ", ".join(map(repr, FRICTION_LAWS)))
-            v_eps = _finite_positive("v_eps", v_eps)
-            if v_eps > 0.1:
-                raise ValueError(f"v_eps = {v_eps!r}: allowed (0, 0.1] m/s")
             fr = {"law": friction_law, "v_eps": float(v_eps),
                   "kA": _finite_positive("bulk_modulus", bulk_modulus)
                   * _finite_positive("cylinder_area", cylinder_area),

@@ -304,3 +304,5 @@ def test_friction_law_is_checked():
         VectorROM(1, friction=True, friction_law="viscous")
     with pytest.raises(ValueError, match="v_eps"):
         VectorROM(1, friction=True, friction_law="regularised", v_eps=0.0)
+    with pytest.raises(ValueError, match="friction_law"):
+        VectorROM(1, friction=False, friction_law=None)
