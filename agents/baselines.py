@@ -678,25 +678,25 @@ def _transfer(caches: dict) -> str:
     return out
 
 
-def _worst(caches: dict, row: str, ref: str = "cubic") -> float:
-    """The lowest paired full-physics difference of ``row`` to ``ref`` over its episodes."""
+def _full_diffs(caches: dict, row: str, ref: str = "cubic") -> np.ndarray:
+    """``row``'s full-physics returns minus ``ref``'s, episode by episode (the episodes both
+    ran, every training seed)."""
     a = caches.get(row, {"seeds": {}})["seeds"]
     b = caches.get(ref, {"seeds": {}})["seeds"]
-    d = [x - y for s in set(a) & set(b)
-         for x, y in zip(a[s].get("full_returns") or [], b[s].get("full_returns") or [])]
-    return float(min(d)) if d else math.nan
+    return np.array([x - y for s in set(a) & set(b)
+                     for x, y in zip(a[s].get("full_returns") or [],
+                                     b[s].get("full_returns") or [])])
 
 
-def _below(caches: dict, row: str, ref: str = "cubic") -> int:
-    """How many of ``row``'s full-physics episodes score below ``ref``'s on the same episode."""
-    a = caches.get(row, {"seeds": {}})["seeds"]
-    b = caches.get(ref, {"seeds": {}})["seeds"]
-    n = 0
-    for s in set(a) & set(b):
-        x, y = a[s].get("full_returns") or [], b[s].get("full_returns") or []
-        k = min(len(x), len(y))
-        n += int(np.sum(np.asarray(x[:k]) < np.asarray(y[:k])))
-    return n
+def _worst(caches: dict, row: str) -> float:
+    """The lowest paired full-physics difference of ``row`` to the cubic over its episodes."""
+    d = _full_diffs(caches, row)
+    return float(d.min()) if d.size else math.nan
+
+
+def _below(caches: dict, row: str) -> int:
+    """How many of ``row``'s full-physics episodes score below the cubic's on the same one."""
+    return int(np.sum(_full_diffs(caches, row) < 0))
 
 
 def _missing(caches: dict) -> str:

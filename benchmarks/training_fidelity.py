@@ -94,8 +94,11 @@ CASES = ("n3-RK45-1e-3", "n3-RK45-1e-4", "n3-RK45-1e-6", "n3-auto-1e-6", "n3-BDF
          "n3-generalized_alpha-1e-3", "n3-ROS2-50-J1", "n3-ROS2-50-J5", "n3-ROS2-25-J1",
          "n9-ROS2-50-J1", "n3-ROS2-50-J1-veps50", "n3-ROS2-50-J5-veps50",
          "n3-RK45-1e-3-veps50-hf30", "n3-ROS2-50-J5-veps50-hf30", "rom", REFERENCE)
-#: a case's model relaxations (suffixes ``-veps{mm/s}``, ``-hf{ms}``): scene key and unit
-RELAX = {"veps": ("contact.v_eps", 1e-3), "hf": ("filtering.h", 1e-3)}
+#: a case's model relaxations (suffixes ``-veps{mm/s}``, ``-hf{ms}``): scene key, the suffix
+#: number's unit, and the table's label of the value
+RELAX = {"veps": ("contact.v_eps", 1e-3, "v_eps = {:g} m/s"),
+         "hf": ("filtering.h", 1e-3, "h_f = {:g} s")}
+RELAX_LABEL = {key: label for key, _, label in RELAX.values()}
 #: ROS2 (Verwer et al. 1999): gamma, and the stage combination y1 = y + h (B1 k1 + B2 k2)
 ROS2_GAMMA = 1.0 + 1.0 / math.sqrt(2.0)
 ROS2_B = (1.5, 0.5)
@@ -403,9 +406,8 @@ def main():
             tol = "–" if case == "rom" else f"{rtol:g}"
         over = relaxed(case)[1]
         if over:
-            tol += "; relaxed model: " + ", ".join(
-                f"{'v_eps' if k == 'contact.v_eps' else 'h_f'} = {v:g} "
-                f"{'m/s' if k == 'contact.v_eps' else 's'}" for k, v in over.items())
+            tol += "; relaxed model: " + ", ".join(RELAX_LABEL[k].format(v)
+                                                   for k, v in over.items())
         dof = f"{n} (modal, 3 modes)" if case == "rom" else f"{n} ({r['n_dof']} DOF)"
         force = "– (no cylinder force)" if math.isnan(e_F) else f"{e_F:.1e}"
         rows.append(f"| {dof} | {method}{label} | {tol} | "

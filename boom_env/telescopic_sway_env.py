@@ -188,8 +188,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from sim_core.vector_rom import (FRICTION_LAWS, ROPE_RANGE, SWAY_LIMIT, TABLE_BOOMS, VectorROM,
-                                 allowed_ranges)
+from sim_core.vector_rom import ROPE_RANGE, SWAY_LIMIT, TABLE_BOOMS, VectorROM, allowed_ranges
 
 from . import _sway_kernel as kernel
 from ._checks import flag as _flag
@@ -313,10 +312,6 @@ class SwayTask:
                       bulk_modulus=_positive("bulk_modulus", bulk_modulus, 1e11),
                       dead_length=_positive("dead_length", dead_length, 100.0),
                       hydraulic_damping=_positive("hydraulic_damping", hydraulic_damping, 0.99))
-        if not isinstance(friction_law, str) or friction_law not in FRICTION_LAWS:
-            raise ValueError(f"friction_law = {friction_law!r}: allowed "
-                             + ", ".join(map(repr, FRICTION_LAWS)))
-        self.friction_law = friction_law
         self.full = fidelity != "rl"
         self.plant = None
         # the full model with friction drives its stages through the oil column of the same
@@ -331,11 +326,12 @@ class SwayTask:
         # the stages' stroke and rate (m, m/s) where the full model's oil column sets them
         self.stage = np.zeros((self.n, 2))
         # the full model takes its friction itself; the ROM then only provides the kinematics
+        # (VectorROM checks friction_law in every case)
         rom_friction = self.friction and not self.full
         self.rom = VectorROM(self.n, booms=self.booms, n_modes=self.n_modes, payload_swing=True,
                              dt=self.dt, v_max=self.v_max, stroke_limits=(self.L_min, self.L_max),
-                             friction=rom_friction,
-                             **(dict(fr, friction_law=friction_law) if rom_friction else {}))
+                             friction=rom_friction, friction_law=friction_law,
+                             **(fr if rom_friction else {}))
         self.rate_max = 2.0 * self.sway_limit * math.sqrt(G / ROPE_RANGE[0])
         low = [self.L_min, -self.v_max, -self.a_max, self.L_min, 0.0, -1.0, -1.0, -10.0, -10.0,
                -self.sway_limit, -self.sway_limit, -self.rate_max, -self.rate_max]

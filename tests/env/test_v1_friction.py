@@ -289,6 +289,20 @@ def test_regularised_law_creeps_where_coulomb_sticks():
     assert np.all(rates_c[:60] == 0.0)                   # held for the first 3 s
 
 
+def test_compiled_law_is_the_full_models_law():
+    """The kernel's mu(v) and d mu / dv are FrictionLaw's (the full model's reference) on both
+    sides of the stick band, through the blend and beyond, to round-off (away from the kink
+    |v| = v_eps, where the reference's slope is one-sided from above)."""
+    from sim_core.physics.contact.sliding_block_contact import FrictionLaw
+    from sim_core.systems.telescopic import _modal_batch_numba as kernel
+    law = FrictionLaw(0.15, 0.1, 0.01)
+    v = np.concatenate([np.linspace(-0.05, 0.05, 1001), [0.0, 0.0099, -0.0101, 0.03]])
+    v = v[np.abs(np.abs(v) - law.v_eps) > 1e-12]
+    got = np.array([kernel._mu_regularised(float(x), 0.15, 0.1, 0.01) for x in v])
+    assert np.allclose(got[:, 0], law.mu(v), rtol=1e-14, atol=1e-16)
+    assert np.allclose(got[:, 1], law.dmu_dv(v), rtol=1e-12, atol=1e-12)
+
+
 def test_regularised_law_takes_the_full_models_coefficients():
     """The ROM's v_eps default is the paper scene's (the full model's law), as are mu_s, mu_k."""
     from sim_core import load_scene

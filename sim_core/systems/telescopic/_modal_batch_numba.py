@@ -514,9 +514,9 @@ def _creep_substep(dyn, grid, ntab, k, xc, vc, ae, e, ed, h, Ms, kA, l0, zh, mus
     v0 = vc + ed
     vc1 = vc + ae * h
     mu0 = _mu_regularised(v0, mus, muk, veps)[0]
-    # R(x) = g x + r0 + N mu(vc1 + x) / 2 = 0 for x = ed1: g > N max|mu'| / 2 for the steps
-    # used (M / h alone is ~1e7 N s/m), so R increases; mu is bounded by mus, which brackets
-    # the root; Newton within the bracket, bisection where it leaves it
+    # R(x) = g x + r0 + N mu(vc1 + x) / 2 = 0 for x = ed1: |mu| <= mus brackets a root;
+    # Newton within the bracket, bisection where it leaves it (at the scene's coefficients
+    # g > N max|mu'| / 2 for h <= 5 ms, M / h alone ~1e7 N s/m: R increases, one root)
     g = Ms / h + 0.25 * kh * h + 0.5 * ch
     r0 = -Ms * ed / h + Ms * ae + kh * (e + 0.25 * h * ed) + 0.5 * ch * ed + 0.5 * Nn * mu0
     lo = (-r0 - 0.5 * Nn * mus) / g
