@@ -14,7 +14,7 @@ Rows (``ROWS``): ``random`` (uniform actions), ``still`` (action 0), the scripte
 ``ppo_vector`` (SB3 PPO with a large batch on the native vector env,
 :class:`boom_env.vector_env.TelescopicSwayVectorEnv`, hyper-parameters
 ``agents/hyperparams/ppo_vector.yml``), ``ppo_finetune`` (``ppo_vector`` trained further on
-the full model), ``ppo_regularised`` (as ``ppo_vector``, trained on the ROM with the full
+the full model's training fidelity, ``fidelity="train"``), ``ppo_regularised`` (as ``ppo_vector``, trained on the ROM with the full
 model's regularised friction law, ``friction_law="regularised"``, and evaluated on the default
 task like every row), ``sac`` (RL Zoo's SAC, ``python -m rl_zoo3.train``
 with ``agents/hyperparams/sac.yml``), ``ppo_scratch`` (RL Zoo's PPO with
@@ -35,7 +35,10 @@ plant (``fidelity=FULL_FIDELITY``: boom_env.full_physics, the payload on its hoi
 stages driven through the cylinder's oil column against the sliders' friction),
 ``FULL_EPISODES`` episodes per training seed: the first of its ROM
 evaluation episodes (same seeds, so the same payload and angle), one at a time (the full model
-steps one crane).
+steps one crane).  The same episodes also run on the full model's training fidelity
+(``fidelity=TRAIN_FIDELITY``: the coarse mesh, ROS2 at the control step, the relaxed
+regularisations; ten times faster than real time), so the table shows how closely each plant
+(ROM, training fidelity) ranks the policies as the paper-accuracy model does.
 
 Each row is cached per training seed in ``RUNS/rows/<row>.json`` (with its budget; a rerun
 reuses finished seeds unless ``--force``), trained models under ``RUNS/<row>/seed<s>``.
@@ -67,6 +70,10 @@ FULL_FIDELITY = "paper"
 #: returns of another plant are run again (with friction the v1 env's full model drives the
 #: stages through the cylinder's oil column, as the ROM does)
 FULL_PLANT = "oil column"
+#: the full model's training fidelity (boom_env.full_physics.FIDELITIES["train"]: coarse mesh,
+#: ROS2 at the control step, relaxed regularisations; above ten times real time): the plant of
+#: the fine-tuning (row ppo_finetune) and of the training-fidelity column
+TRAIN_FIDELITY = "train"
 HYPER = Path(__file__).resolve().parent / "hyperparams"
 ROWS = ("random", "still", "cubic", "trapezoid", "zv_trapezoid", "ppo_vector", "ppo_finetune",
         "ppo_regularised", "sac", "ppo_scratch", "ppo_residual")
@@ -76,12 +83,12 @@ TRAINED = ("ppo_vector", "ppo_finetune", "ppo_regularised", "sac", "ppo_scratch"
 LABELS = {"random": "random actions", "still": "standing still (action 0)",
           "cubic": "cubic schedule (paper)", "trapezoid": "trapezoid schedule",
           "zv_trapezoid": "ZV-shaped trapezoid", "ppo_vector": "PPO, large batch, vector env",
-          "ppo_finetune": "the large-batch PPO fine-tuned on the full model",
+          "ppo_finetune": "the large-batch PPO fine-tuned on the full model's training fidelity",
           "ppo_regularised": "PPO, large batch, trained with the full model's friction law",
           "sac": "SAC (RL Zoo)", "ppo_scratch": "PPO from scratch (RL Zoo)",
           "ppo_residual": "residual PPO on the cubic"}
 # env steps of training per seed
-BUDGETS = {"ppo_vector": 10_000_000, "ppo_finetune": 1_200, "ppo_regularised": 10_000_000,
+BUDGETS = {"ppo_vector": 10_000_000, "ppo_finetune": 60_000, "ppo_regularised": 10_000_000,
            "sac": 100_000,
            "ppo_scratch": 200_000, "ppo_residual": 100_000}
 QUICK_BUDGETS = {"ppo_vector": 2 * 64 * 8, "ppo_finetune": 8, "ppo_regularised": 2 * 64 * 8,
@@ -205,22 +212,23 @@ def residual_vector(n: int, meta: dict):
 
 
 def full_physics_returns(act, seed: int, episodes: int, residual: dict | None = None,
-                         **env_kw) -> list[float]:
+                         fidelity: str = FULL_FIDELITY, **env_kw) -> list[float]:
     """Returns of ``episodes`` episodes of the v1 task on the full sim_core model
     (``fidelity=FULL_FIDELITY``: the payload on its hoist rope, the sliders' friction), episode
     i reset with seed + i, payload and angle randomised as in the ROM evaluation (the same
     draws: the ROM column's episode i has the same payload and angle); ``residual``: the
-    residual policy's model_meta.json (the policy acts through its wrapper); ``env_kw``: more
-    env kwargs (tests shorten ``t_max``)."""
+    residual policy's model_meta.json (the policy acts through its wrapper); ``fidelity``: the
+    full model's (TRAIN_FIDELITY for the training-fidelity column); ``env_kw``: more env kwargs
+    (tests shorten ``t_max``)."""
     import gymnasium as gym
 
     import boom_env  # noqa: F401
     out = []
     for i in range(episodes):
         if residual is None:
-            env = gym.make(ENV_ID, fidelity=FULL_FIDELITY, **env_kwargs(**env_kw))
+            env = gym.make(ENV_ID, fidelity=fidelity, **env_kwargs(**env_kw))
         else:
-            env = _residual_env(residual, fidelity=FULL_FIDELITY, **env_kw)
+            env = _residual_env(residual, fidelity=fidelity, **env_kw)
         obs, _ = env.reset(seed=seed + i)
         total, k, done = 0.0, 0, False
         while not done:
@@ -230,7 +238,7 @@ def full_physics_returns(act, seed: int, episodes: int, residual: dict | None = 
             done = term or trunc
             k += 1
         if info.get("diverged"):
-            print(f"[baselines] full-physics episode {seed + i}: truncated, {info['reason']}",
+            print(f"[baselines] {fidelity} episode {seed + i}: truncated, {info['reason']}",
                   flush=True)
         out.append(total)
         env.close()
@@ -293,10 +301,10 @@ def train_ppo_vector(seed: int, steps: int, out: Path, quick: bool = False, **en
 
 def train_finetune(seed: int, steps: int, out: Path, runs: Path, quick: bool = False) -> dict:
     """The large-batch PPO of training seed ``seed`` (row ppo_vector of the run cache
-    ``runs``) trained on for ``steps`` env steps on the full model (``fidelity=FULL_FIDELITY``,
-    one crane, payload and angle randomised as in the evaluation) with ``FINETUNE``'s
-    settings; its VecNormalize statistics are frozen (a few thousand full-model steps would
-    move them by noise)."""
+    ``runs``) trained on for ``steps`` env steps on the full model's training fidelity
+    (``fidelity=TRAIN_FIDELITY``, one crane, payload and angle randomised as in the
+    evaluation) with ``FINETUNE``'s settings; its VecNormalize statistics are frozen (the
+    fine-tuning's steps are far fewer than the ROM training's, and would move them by noise)."""
     import gymnasium as gym
     import torch
     from stable_baselines3 import PPO
@@ -317,7 +325,7 @@ def train_finetune(seed: int, steps: int, out: Path, runs: Path, quick: bool = F
     curve = []
 
     def make():
-        return Monitor(gym.make(ENV_ID, fidelity=FULL_FIDELITY, **env_kwargs()))
+        return Monitor(gym.make(ENV_ID, fidelity=TRAIN_FIDELITY, **env_kwargs()))
     venv = VecNormalize.load(base["vecnorm"], DummyVecEnv([make]))
     venv.training = False
     venv.seed(seed)
@@ -461,26 +469,39 @@ def evaluate_rom(row: str, seed: int, rec: dict, runs: Path) -> None:
 
 def add_full(row: str, seed: int, rec: dict, full_episodes: int, runs: Path) -> bool:
     """Bring the full-physics returns of training seed ``seed`` to its first ``full_episodes``
-    evaluation episodes (only the missing ones run; those of another fidelity are replaced);
-    True if any ran."""
-    if rec.get("full_fidelity") != FULL_FIDELITY or rec.get("full_plant") != FULL_PLANT:
-        rec.pop("full_returns", None)
-        rec.pop("full_wall_s", None)
-    have = list(rec.get("full_returns") or [])
-    if full_episodes <= len(have):
-        return False
-    act = actor_for(row, seed, rec if row in TRAINED else None)
-    meta = None
-    if row == "ppo_residual":
-        with open(runs / row / f"seed{seed}" / "model_meta.json") as f:
-            meta = json.load(f)
-    t0 = time.perf_counter()
-    rec["full_returns"] = have + full_physics_returns(act, eval_seed(seed) + len(have),
-                                                      full_episodes - len(have), meta)
-    rec["full_fidelity"] = FULL_FIDELITY
-    rec["full_plant"] = FULL_PLANT
-    rec["full_wall_s"] = float(rec.get("full_wall_s", 0.0)) + time.perf_counter() - t0
-    return True
+    evaluation episodes, at the paper-accuracy fidelity (``full_returns``) and at the training
+    fidelity (``trainfid_returns``); only the missing ones run, those of another fidelity or
+    plant (:func:`_plant`) are replaced.  True if any ran."""
+    ran = False
+    for key, fidelity in (("full", FULL_FIDELITY), ("trainfid", TRAIN_FIDELITY)):
+        if rec.get(f"{key}_fidelity") != fidelity or rec.get(f"{key}_plant") != _plant(fidelity):
+            rec.pop(f"{key}_returns", None)
+            rec.pop(f"{key}_wall_s", None)
+        have = list(rec.get(f"{key}_returns") or [])
+        if full_episodes <= len(have):
+            continue
+        act = actor_for(row, seed, rec if row in TRAINED else None)
+        meta = None
+        if row == "ppo_residual":
+            with open(runs / row / f"seed{seed}" / "model_meta.json") as f:
+                meta = json.load(f)
+        t0 = time.perf_counter()
+        rec[f"{key}_returns"] = have + full_physics_returns(
+            act, eval_seed(seed) + len(have), full_episodes - len(have), meta, fidelity)
+        rec[f"{key}_fidelity"] = fidelity
+        rec[f"{key}_plant"] = _plant(fidelity)
+        rec[f"{key}_wall_s"] = float(rec.get(f"{key}_wall_s", 0.0)) + time.perf_counter() - t0
+        ran = True
+    return ran
+
+
+def _plant(fidelity: str) -> str:
+    """What a cached full-model return was computed on: FULL_PLANT and, for the training
+    fidelity, its settings (boom_env.full_physics.FIDELITIES), so a changed setting reruns it."""
+    if fidelity != TRAIN_FIDELITY:
+        return FULL_PLANT
+    from boom_env.full_physics import FIDELITIES
+    return f"{FULL_PLANT}; {json.dumps(FIDELITIES[fidelity], sort_keys=True)}"
 
 
 def _save_seed(path: Path, seed: int, rec: dict) -> None:
@@ -516,7 +537,9 @@ HEADER = ("row", "training budget (env steps per seed)", "seeds", "ROM return (m
           "ROM return minus the cubic's, same episodes (mean ± s.e.)",
           "ROM episodes", "ROM success", "full-physics return (mean ± std)",
           "full-physics return minus the cubic's, same episodes (mean ± s.e.)",
-          "full-physics episodes", "training wall time per seed (s)",
+          "full-physics episodes",
+          "training-fidelity return minus the cubic's, same episodes (mean ± s.e.)",
+          "training wall time per seed (s)",
           "load average (1 min) at the end of each seed's run")
 
 
@@ -539,7 +562,7 @@ def table_rows(caches: dict) -> list[list[str]]:
         budget = "-" if row not in TRAINED else (
             f"{recs[0]['budget']:,}" if recs else f"{BUDGETS[row]:,} (not run)")
         if row == "ppo_finetune" and budget != "-":
-            budget = f"`ppo_vector`'s, then {budget} on the full model"
+            budget = f"`ppo_vector`'s, then {budget} on the training fidelity"
         walls = [r["train_wall_s"] for r in recs if "train_wall_s" in r]
         eps = ", ".join(str(r["episodes"]) for r in recs)
         out.append([LABELS[row] + f" (`{row}`)", budget,
@@ -550,6 +573,8 @@ def table_rows(caches: dict) -> list[list[str]]:
                     _pm(full) if full else "not run",
                     _paired_cell(caches, row, "full_returns") if full else "not run",
                     _full_count(recs),
+                    _paired_cell(caches, row, "trainfid_returns") if any(
+                        r.get("trainfid_returns") for r in recs) else "not run",
                     ", ".join(f"{w:.0f}" for w in walls) if walls else "-",
                     ", ".join(f"{r['load_after'][0]:.1f}" for r in recs if "load_after" in r)
                     or "-"])
@@ -626,7 +651,7 @@ def verdict(caches: dict) -> str:
     else:
         out = (head + "The PPO does NOT beat the cubic schedule on the ROM (not above it by "
                "two standard errors).  " + shipped + EARLIER_TRIALS)
-    return out + _transfer(caches)
+    return out + _transfer(caches) + _agreement(caches)
 
 
 def _per_seed(caches: dict, row: str) -> list[tuple[str, float]]:
@@ -661,6 +686,19 @@ def _transfer(caches: dict) -> str:
                 "vibration within a factor of about 2, the full model's regularised friction "
                 "law, which creeps where the ROM's sticks) and overshoots: docs/environment.md, "
                 "v1's fidelities, has one episode traced.")
+    f = paired(caches, "ppo_finetune", key="full_returns")
+    if p is not None and f is not None:
+        above = f[2] - _below(caches, "ppo_finetune")
+        out += ("  Fine-tuned on the full model's training fidelity (`ppo_finetune`: the same "
+                "PPO trained on for "
+                f"{_budget(caches, 'ppo_finetune')} env steps at ten times real time), it "
+                f"scores {f[0]:+.3f} ± {f[1]:.3f} against the cubic on the paper-accuracy full "
+                f"model ({above} of {f[2]} episodes above it; before the fine-tuning "
+                f"{p[0]:+.3f}): "
+                + ("it beats the cubic schedule on the full model." if f[0] - 2 * f[1] > 0
+                   else ("the fine-tuning removes the transfer loss, but "
+                         if f[0] + 2 * f[1] > 0 > p[0] + 2 * p[1] else "")
+                   + "it does not beat the cubic schedule on the full model."))
     r = paired(caches, "ppo_regularised", key="full_returns")
     if p is not None and r is not None:
         worst = {row: _worst(caches, row) for row in ("ppo_vector", "ppo_regularised")}
@@ -676,6 +714,47 @@ def _transfer(caches: dict) -> str:
                     > 0.25 * worst["ppo_vector"] else "")
                    + "it does not beat the cubic schedule on the full model."))
     return out
+
+
+def _agreement(caches: dict) -> str:
+    """How closely the ROM and the training fidelity rank the rows as the paper-accuracy full
+    model does: each row's mean paired difference to the cubic on the episodes all three
+    plants ran (the ROM's first evaluation episodes), their mean absolute deviation from the
+    full model's and the rank correlation (Spearman) over the rows."""
+    from scipy.stats import spearmanr
+    rows, per = [], {"returns": [], "trainfid_returns": [], "full_returns": []}
+    for row in ROWS:
+        if row == "cubic":
+            continue
+        a = caches.get(row, {"seeds": {}})["seeds"]
+        b = caches.get("cubic", {"seeds": {}})["seeds"]
+        d = {key: [] for key in per}
+        for s in sorted(set(a) & set(b), key=int):
+            k = min(len(x[s].get(key) or []) for key in per for x in (a, b))
+            for key in per:
+                if k:
+                    d[key] += list(np.asarray(a[s][key][:k]) - np.asarray(b[s][key][:k]))
+        if d["full_returns"]:
+            rows.append(row)
+            for key in per:
+                per[key].append(float(np.mean(d[key])))
+    if len(rows) < 3:
+        return ""
+    full = np.array(per["full_returns"])
+    cells = []
+    for key, name in (("returns", "the ROM"), ("trainfid_returns", "the training fidelity")):
+        x = np.array(per[key])
+        rho = spearmanr(x, full).statistic
+        cells.append(f"{name} {np.mean(np.abs(x - full)):.3f} (rank correlation {rho:.2f})")
+    return ("\n\nThe plants against the paper-accuracy model: each row's mean return minus the "
+            f"cubic's on the episodes all three plants ran ({len(rows)} rows), its mean "
+            "absolute deviation from the full model's: " + "; ".join(cells) + ".")
+
+
+def _budget(caches: dict, row: str) -> str:
+    """The training budget of ``row``'s cached seeds (env steps), as the table writes it."""
+    b = {r.get("budget") for r in caches.get(row, {"seeds": {}})["seeds"].values()}
+    return ", ".join(f"{x:,}" for x in sorted(x for x in b if x is not None)) or "-"
 
 
 def _full_diffs(caches: dict, row: str, ref: str = "cubic") -> np.ndarray:
@@ -741,6 +820,12 @@ def write_table(path: Path, caches: dict, machine: list[str], quick: bool) -> No
              "every row, so the "
              "paired difference to the cubic's is on the same cranes.",
              "",
+             "Training fidelity: the same episodes on the full model's training fidelity "
+             f"(`fidelity=\"{TRAIN_FIDELITY}\"`: the coarse mesh, the Rosenbrock-W method ROS2 "
+             "at the control step, the friction's stick band and the stress filter's window "
+             "relaxed; more than ten times faster than real time, "
+             "benchmarks/results/training_fidelity.md), the plant the fine-tuned row trains on.",
+             "",
              "Training wall time: the training alone, without the evaluation, each run pinned "
              "to one core of the machine below (2 cores); at most two ran side by side.  The "
              "last column gives the load average when each seed's run ended: above about 2, "
@@ -756,7 +841,8 @@ def write_table(path: Path, caches: dict, machine: list[str], quick: bool) -> No
     lines += ["", verdict(caches), "",
               "Budgets: PPO large batch: agents/hyperparams/ppo_vector.yml on the native vector "
               "env; fine-tuned: each seed's large-batch PPO trained on for the budget's env steps "
-              f"on the full model (`fidelity=\"{FULL_FIDELITY}\"`, one crane; PPO with a rollout of "
+              f"on the full model's training fidelity (`fidelity=\"{TRAIN_FIDELITY}\"`, one "
+              "crane, payload and angle randomised as in the evaluation; PPO with a rollout of "
               f"{FINETUNE['n_steps']} steps, minibatch {FINETUNE['batch_size']}, "
               f"{FINETUNE['n_epochs']} epochs, learning rate {FINETUNE['learning_rate']:g}, the "
               "ROM training's normalisation frozen); trained with the full model's friction "
@@ -789,12 +875,12 @@ def plot_curves(path: Path, caches: dict) -> None:
                         ms=3)
         if row != "ppo_residual":     # the residual's training return has its tracking term
             cc = caches.get("cubic", {"seeds": {}})["seeds"]
-            key = "full_returns" if row == "ppo_finetune" else "returns"   # its plant's
+            key = "trainfid_returns" if row == "ppo_finetune" else "returns"   # its plant's
             r = [x for v in cc.values() for x in (v.get(key) or [])]
             if r:
                 ax.axhline(np.mean(r), color="k", ls="--", lw=0.8,
-                           label="cubic schedule (evaluation" + (", full model)"
-                                                                 if key == "full_returns" else ")"))
+                           label="cubic schedule (evaluation" + (", training fidelity)"
+                                                                 if key != "returns" else ")"))
         ax.set_title(LABELS[row], fontsize=9)
         ax.set_xlabel("env steps")
         ax.set_ylabel("training return" + (" (with tracking term)" if row == "ppo_residual"

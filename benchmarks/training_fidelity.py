@@ -6,7 +6,8 @@ the env's episode, friction on.
 The episode: the paper's extraction (scene ``telescopic_extraction``: three booms, 25 t,
 60 deg, L_s 2 -> 8 m on the cubic schedule, 16 s of motion, friction 0.1/0.15) over 30 s, the
 length of a ``boom_env`` episode, stepped as the env steps it: :class:`sim_core.Simulation`
-advanced in control steps of 0.05 s (each a fresh integration from the current state), the tip
+advanced in control steps of 0.05 s (each a fresh integration from the current state; ROS2
+keeps its Jacobian from step to step), the tip
 read after every step (the light outputs the env reads).  Each case runs in a child process
 pinned to core 0 (``taskset -c 0``), one case at a time; its wall and CPU seconds cover the
 steps and the tip reads, not the build and the static equilibrium (``reset``, timed apart),
@@ -20,18 +21,16 @@ drive's nonlinear constraints, and the row says so).  The reference ("paper accu
 paper scene's own settings, ``n9-auto-1e-6``, stepped the same way.
 
 The cost floor: a right-hand side of the model costs about 1 ms at 3 nodes on one core
-(benchmarks/results/telescopic_rhs_speed.md), so a real-time factor of 10 leaves about 6 of
-them per 0.05 s control step, Jacobians included (one structured Jacobian costs ~18).  The
+(benchmarks/results/telescopic_rhs_speed.md), so a real-time factor of 10 leaves about 5 of
+them per 0.05 s control step, Jacobians included (one structured Jacobian costs ~20).  The
 error-controlled methods above spend 50-80.  The only integrators within that budget are
 linearly implicit ones at the control step, and the cases ``n{n_nodes}-ROS2-{h in ms}-J{k}``
-measure them: the Rosenbrock-W method ROS2 (Verwer, Spee, Blom & Hundsdorfer 1999, SIAM J.
-Sci. Comput. 20(4): gamma = 1 + 1/sqrt(2), order 2 with any Jacobian approximation, L-stable
-with the exact one) at the fixed step h, with the structured Jacobian renewed at the start of
-every k-th control step; in the control steps between renewals a step whose end leaves or
-enters a contact's friction slope band (``Model.friction_in_slope_band``) is repeated in two
-halves with a new Jacobian, and so is a failed or non-finite step, down to h/8
-(:class:`Ros2Stepper`).  Its two stages and the right-hand side at the step's end (the next
-step's first) make 3 right-hand sides per step.  The case ``rom`` is the modal reduced-order
+measure one: ``solver.method = "ROS2"`` (:mod:`sim_core.integrate.rosenbrock`, the
+Rosenbrock-W method of Verwer, Spee, Blom & Hundsdorfer 1999, second order with any Jacobian
+approximation) at the fixed step h, its structured Jacobian renewed every k control steps
+(``solver.jacobian_interval`` = k x 0.05 s) and at once where a step crosses the friction law's
+slope band.  Two right-hand sides per step and one at each control step's start (the drives'
+clock moves there).  The case ``rom`` is the modal reduced-order
 model the envs train on (scene ``telescopic_extraction_rl``, 3 modes: the same crane and cubic
 schedule, frictionless, no cylinder force), stepped the same way, for the accuracy the envs'
 cheapest fidelity has on this episode.
@@ -53,9 +52,10 @@ Errors against the reference at the 601 step ends:
 * force: the largest |F(t) - F_ref(t)| of the telescopic cylinder force over the reference
   force's range (max - min).
 
-``--env-episode FIDELITY`` runs one whole ``boom_env`` episode at that fidelity (the cubic
-schedule as actions) and prints its time, for timing the whole process from outside (the
-figure the table quotes for the chosen fidelity).
+``--env-episode FIDELITY`` (with ``--env-id``, default the v0 extraction) runs one whole
+``boom_env`` episode at that fidelity (the cubic schedule as actions) and prints its time, for
+timing the whole process from outside (the figures the table quotes for the chosen
+fidelities).
 
 Writes benchmarks/results/training_fidelity.md with the machine state
 (:func:`_machine.machine_lines`) and each case's busy share of both cores.  Child results are
@@ -91,22 +91,25 @@ REFERENCE = "n9-auto-1e-6"
 CASES = ("n3-RK45-1e-3", "n3-RK45-1e-4", "n3-RK45-1e-6", "n3-auto-1e-6", "n3-BDF-1e-3",
          "n3-BDF-1e-4", "n5-RK45-1e-3", "n5-RK45-1e-5", "n5-BDF-1e-4", "n7-RK45-1e-5",
          "n9-RK45-1e-3", "n9-RK45-1e-4", "n9-RK45-1e-5", "n9-BDF-1e-4", "n9-BDF-1e-5",
-         "n3-generalized_alpha-1e-3", "n3-ROS2-50-J1", "n3-ROS2-50-J5", "n3-ROS2-25-J1",
-         "n9-ROS2-50-J1", "n3-ROS2-50-J1-veps50", "n3-ROS2-50-J5-veps50",
-         "n3-RK45-1e-3-veps50-hf30", "n3-ROS2-50-J5-veps50-hf30", "rom", REFERENCE)
+         "n3-generalized_alpha-1e-3", "n3-ROS2-50-J1", "n3-ROS2-50-J10", "n3-ROS2-25-J1",
+         "n9-ROS2-50-J1", "n3-ROS2-50-J1-veps50", "n3-ROS2-50-J10-veps50",
+         "n3-ROS2-50-J20-veps50", "n3-RK45-1e-3-veps50-hf30", "n3-ROS2-50-J1-veps50-hf30",
+         "n3-ROS2-50-J10-veps50-hf30", "n3-ROS2-50-J20-veps50-hf30",
+         "n3-ROS2-50-J40-veps50-hf30", "n5-ROS2-50-J10-veps50-hf30", "rom", REFERENCE)
 #: a case's model relaxations (suffixes ``-veps{mm/s}``, ``-hf{ms}``): scene key, the suffix
 #: number's unit, and the table's label of the value
 RELAX = {"veps": ("contact.v_eps", 1e-3, "v_eps = {:g} m/s"),
          "hf": ("filtering.h", 1e-3, "h_f = {:g} s")}
 RELAX_LABEL = {key: label for key, _, label in RELAX.values()}
-#: ROS2 (Verwer et al. 1999): gamma, and the stage combination y1 = y + h (B1 k1 + B2 k2)
-ROS2_GAMMA = 1.0 + 1.0 / math.sqrt(2.0)
-ROS2_B = (1.5, 0.5)
 #: the largest tip error (m) and force error (share of the range) a training fidelity may
 #: have: the env's success tolerance on the deflection (0.2 mm, three booms: an error below it
 #: cannot turn a clear success into a failure), and 5 % of the force's range
 TIP_OK, FORCE_OK = 2e-4, 0.05
 RTF_GOAL = 10.0
+#: the training choice's speed margin over the goal on this episode's plant: the v1 env's
+#: plant adds the cylinder's oil column and the payload's hoist rope, about 15 % more work per
+#: step (the whole-process timings below), so its cases must reach RTF_GOAL * (1 + ENV_MARGIN)
+ENV_MARGIN = 0.2
 
 
 def relaxed(case: str) -> tuple[str, dict]:
@@ -145,104 +148,19 @@ def scene_for(case: str, t_end: float) -> dict:
     if case == "rom":
         return load_scene("telescopic_extraction_rl", overrides={"solver.t_end": t_end})
     n, method, rtol = parse(case)
-    if method == "ROS2":         # the solver settings are not used (Ros2Stepper integrates)
-        method, rtol = "RK45", 1e-6
-    ov = {"booms.n_nodes": n, "solver.method": method, "solver.rtol": rtol,
-          "solver.atol": rtol / 10, "solver.t_end": t_end, "effects.friction": True,
-          **relaxed(case)[1]}
+    if method == "ROS2":
+        h, k = ros2_setting(case)
+        solver = {"solver.h": h, "solver.jacobian_interval": k * DT}
+    else:
+        solver = {"solver.rtol": rtol, "solver.atol": rtol / 10}
+    ov = {"booms.n_nodes": n, "solver.method": method, **solver, "solver.t_end": t_end,
+          "effects.friction": True, **relaxed(case)[1]}
     return load_scene("telescopic_extraction", overrides=ov)
-
-
-class Ros2Stepper:
-    """The full model's stepper advanced with ROS2 at a fixed step instead of its scene's
-    integrator (module docstring): ``advance(dt)`` replaces ``TelescopicStepper.advance`` for
-    the scene's own drive profile.  Stages (Verwer et al. 1999, Eq. 2.2, W-form; the model's
-    drives are smooth within a control step, and the time derivative of f is left out as the
-    W-method allows at order 2 only for autonomous problems, so on the drive's ramps it is
-    first order in the forcing's change; the table measures the result):
-
-        (I - gamma h J) k1 = f(t, y),   (I - gamma h J) k2 = f(t + h, y + h k1) - 2 k1,
-        y1 = y + h (3/2 k1 + 1/2 k2),
-
-    J = [[0, I], [J_zz, J_zv]] the structured state Jacobian, solved through its velocity
-    block I - gamma h J_zv - (gamma h)^2 J_zz (one n x n LU per Jacobian and step size)."""
-
-    def __init__(self, impl, h: float, every: int):
-        from sim_core.model.state_jacobian import state_jacobian
-        self.impl, self.h, self.every = impl, h, every
-        self.m = impl.ts.model
-        self.n = self.m.n_dof
-        self.jacobian = state_jacobian
-        self.stats = {"n_steps": 0, "n_rhs": 0, "n_jacobians": 0}
-        self.since = math.inf            # control steps since the last Jacobian
-        self.band = None                 # friction_in_slope_band where the Jacobian was made
-        self.lu = self.lu_h = None
-
-    def rhs(self, tau, y):
-        self.stats["n_rhs"] += 1
-        return self.m.rhs(tau, y)
-
-    def renew(self, tau, y) -> None:
-        n = self.n
-        J = self.jacobian(self.m, tau, y)
-        self.stats["n_jacobians"] += 1
-        self.Jzz, self.Jzv = J[n:, :n].copy(), J[n:, n:].copy()
-        self.band = self.m.friction_in_slope_band(tau, y[:n], y[n:])
-        self.since, self.lu_h = 0, None
-
-    def solve(self, r, gh):
-        import scipy.linalg as sla
-        n = self.n
-        if self.lu_h != gh:
-            self.lu = sla.lu_factor(np.eye(n) - gh * self.Jzv - gh * gh * self.Jzz,
-                                    check_finite=False)
-            self.lu_h = gh
-        kv = sla.lu_solve(self.lu, r[n:] + gh * (self.Jzz @ r[:n]), check_finite=False)
-        return np.concatenate([r[:n] + gh * kv, kv])
-
-    def step(self, tau, y, h, f0, depth=0):
-        """One step from (tau, y) with f0 = f(tau, y): (y1, f(tau + h, y1))."""
-        n, gh = self.n, ROS2_GAMMA * h
-        ok = False
-        try:
-            k1 = self.solve(f0, gh)
-            k2 = self.solve(self.rhs(tau + h, y + h * k1) - 2.0 * k1, gh)
-            y1 = y + h * (ROS2_B[0] * k1 + ROS2_B[1] * k2)
-            f1 = self.rhs(tau + h, y1)
-            ok = bool(np.all(np.isfinite(f1)))
-            if ok and self.since > 0 and \
-                    self.m.friction_in_slope_band(tau + h, y1[:n], y1[n:]) != self.band:
-                ok = False               # the friction's regime changed: a new Jacobian
-        except Exception:                # a failed solve in the right-hand side
-            ok = False
-        if ok:
-            self.stats["n_steps"] += 1
-            return y1, f1
-        if depth >= 3:
-            raise RuntimeError(f"ROS2 failed at t = {self.impl.t + tau:.4f} s")
-        self.renew(tau, y)
-        ym, fm = self.step(tau, y, h / 2, f0, depth + 1)
-        return self.step(tau + h / 2, ym, h / 2, fm, depth + 1)
-
-    def advance(self, dt: float) -> None:
-        impl = self.impl
-        impl.clock[0] = impl.t
-        y = impl.y.copy()
-        f = self.rhs(0.0, y)             # the drives read the time from the step's start
-        if self.since >= self.every:
-            self.renew(0.0, y)
-        k = int(round(dt / self.h))
-        for j in range(k):
-            y, f = self.step(j * self.h, y, self.h, f)
-        self.since += 1
-        impl.y, impl.t = y, impl.t + dt
-        for d in impl.drives.values():
-            d.settle(impl.t)
 
 
 def run_child(case: str, t_end: float, path: str) -> None:
     """One case in this process: the episode stepped at DT; arrays and clocks to ``path``."""
-    from sim_core import SceneError, Simulation
+    from sim_core import SceneError, Simulation, SimulationError
     try:
         sc = scene_for(case, t_end)
     except SceneError as exc:
@@ -256,9 +174,6 @@ def run_child(case: str, t_end: float, path: str) -> None:
     tips, forces, strokes = [], [], []
     rom = case == "rom"
     advance, stats = sim.advance, (lambda: sim.stats)
-    if parse(case)[1] == "ROS2":
-        ros2 = Ros2Stepper(sim._impl, *ros2_setting(case))
-        advance, stats = ros2.advance, (lambda: ros2.stats)
 
     def record():
         if rom:
@@ -276,11 +191,16 @@ def run_child(case: str, t_end: float, path: str) -> None:
     wall = cpu = 0.0
     for _ in range(n):
         w0, c0 = time.perf_counter(), time.process_time()
-        advance(DT)
-        sim.outputs(("tip_position", "tip_velocity"))        # what the env reads per step
-        wall += time.perf_counter() - w0
-        cpu += time.process_time() - c0
-        record()
+        try:
+            advance(DT)
+            sim.outputs(("tip_position", "tip_velocity"))    # what the env reads per step
+            wall += time.perf_counter() - w0
+            cpu += time.process_time() - c0
+            record()
+        except SimulationError as exc:          # the case's row says where and why
+            with open(path, "w") as f:
+                json.dump({"case": case, "failed": str(exc)}, f)
+            return
     with open(path, "w") as f:
         json.dump({"case": case, "reset_s": reset, "wall_s": wall, "cpu_s": cpu,
                    "t_end": t_end, **stats(),
@@ -317,6 +237,12 @@ def errors(res: dict, ref: dict) -> tuple[float, float, float]:
     return float(e.max()), float(np.sqrt(np.mean(e * e))), e_F
 
 
+def median_force(res: dict, ref: dict) -> float:
+    """The median |F - F_ref| over the step ends, over the reference force's range."""
+    F, Fref = np.asarray(res["force"]), np.asarray(ref["force"])
+    return float(np.median(np.abs(F - Fref)) / (Fref.max() - Fref.min()))
+
+
 def deflection(res: dict) -> float:
     """The largest deflection (m) of the env's observation over the run: the tip's displacement
     from its start less the static tip's change along the stroke (the modal tables)."""
@@ -329,25 +255,32 @@ def deflection(res: dict) -> float:
     return float(np.max(np.hypot(d[:, 0], d[:, 2])))
 
 
-def env_episode(fidelity: str) -> None:
-    """One whole env episode (600 steps of 0.05 s) at ``fidelity``, the paper's cubic schedule
-    as actions (each step's mean acceleration); prints the steps' wall seconds and the
-    real-time factor (for timing the whole process from outside)."""
+def env_episode(fidelity: str, env_id: str = "boom_env/TelescopicExtraction-v0") -> None:
+    """One whole env episode (600 steps of 0.05 s) of ``env_id`` at ``fidelity``, the paper's
+    cubic schedule as actions (each step's mean acceleration, from the reset's stroke); prints
+    the steps' wall seconds and the real-time factor (for timing the whole process from
+    outside)."""
+    import gymnasium as gym
+
     import boom_env  # noqa: F401
-    from boom_env import TelescopicBoomEnv
     from sim_core.profiles import CubicSmoothstepSchedule
-    env = TelescopicBoomEnv(fidelity=fidelity)
+    env = gym.make(env_id, fidelity=fidelity)
     env.reset(seed=0)
+    base = env.unwrapped
+    a_max = float(np.ravel(getattr(base, "a_max", None) or base.core.a_max)[0])
     sched = CubicSmoothstepSchedule(v_max=0.5, t_ramp=4.0, t_hold_end=12.0, s0=2.0)
-    n = int(round(env.t_max / env.dt))
+    n = int(round(T_END / DT))
     w0 = time.perf_counter()
     for k in range(n):
-        a = (sched.rate((k + 1) * env.dt) - sched.rate(k * env.dt)) / env.dt
-        *_, trunc, info = env.step(np.array([a / env.a_max], np.float32))
-        if info["diverged"]:
+        a = (sched.rate((k + 1) * DT) - sched.rate(k * DT)) / DT
+        *_, term, trunc, info = env.step(np.array([a / a_max], np.float32))
+        if info.get("diverged"):
             raise RuntimeError(info["reason"])
+        if term or trunc:
+            env.reset()
     wall = time.perf_counter() - w0
-    print(f"{fidelity}: {n} steps in {wall:.2f} s, real-time factor {n * env.dt / wall:.2f}")
+    print(f"{env_id} {fidelity}: {n} steps in {wall:.2f} s, real-time factor "
+          f"{n * DT / wall:.2f}")
 
 
 def main():
@@ -363,6 +296,8 @@ def main():
                          "(pinned to core 0, timed from outside), quoted into the table")
     ap.add_argument("--env-episode", metavar="FIDELITY",
                     help="run one env episode at this fidelity and print its time (no table)")
+    ap.add_argument("--env-id", default="boom_env/TelescopicExtraction-v0",
+                    help="the env of --env-episode")
     ap.add_argument("--child", help=argparse.SUPPRESS)
     ap.add_argument("--result", help=argparse.SUPPRESS)
     a = ap.parse_args()
@@ -370,7 +305,7 @@ def main():
         run_child(a.child, a.t_end, a.result)
         return
     if a.env_episode:
-        env_episode(a.env_episode)
+        env_episode(a.env_episode, a.env_id)
         return
     os.makedirs(a.work, exist_ok=True)
     cases = list(dict.fromkeys(a.cases + [REFERENCE]))
@@ -380,18 +315,19 @@ def main():
         t0 = time.perf_counter()
         results[case] = run_case(case, a.t_end, a.work, a.fresh or case in a.rerun)
         r = results[case]
-        print(case, "refused" if "refused" in r else
+        print(case, r.get("refused", r.get("failed")) if "refused" in r or "failed" in r else
               f"wall {r['wall_s']:.1f} s cpu {r['cpu_s']:.1f} s ({time.perf_counter() - t0:.0f} s)",
               flush=True)
     cpu1, load1 = cpu_times(), os.getloadavg()
     ref = results[REFERENCE]
-    rows, ok = [], []
+    rows, ok, fast = [], [], []
     for case in cases:
         r = results[case]
         n, method, rtol = parse(case)
-        if "refused" in r:
-            rows.append(f"| {n} | {method} | {rtol:g} | refused by the scene: {r['refused']} "
-                        "| | | | | | | | |")
+        if "refused" in r or "failed" in r:
+            what = (f"refused by the scene: {r['refused']}" if "refused" in r
+                    else f"failed: {r['failed']}")
+            rows.append(f"| {n} | {method} | {case} | {what} | | | | | | | | |")
             continue
         e_tip, e_rms, e_F = errors(r, ref)
         rtf, rtf_cpu = r["t_end"] / r["wall_s"], r["t_end"] / r["cpu_s"]
@@ -415,6 +351,8 @@ def main():
                     f"{r['reset_s']:.2f} | {e_tip:.1e} | {e_rms:.1e} | {force} | {busy} |")
         if case != REFERENCE and e_tip <= TIP_OK and e_F <= FORCE_OK:
             ok.append((rtf_cpu, case, rtf, e_tip, e_F, r.get("n_rhs", math.inf)))
+        if case not in (REFERENCE, "rom") and rtf_cpu >= RTF_GOAL * (1.0 + ENV_MARGIN):
+            fast.append((e_tip, case, rtf_cpu, e_rms, e_F))
     d_max = deflection(ref)
     F = np.asarray(ref["force"])
     if ok:
@@ -433,6 +371,28 @@ def main():
                    + f" the goal of a real-time factor >= {RTF_GOAL:g} on one core.")
     else:
         verdict = "No case lies within the error bounds."
+    if fast:
+        # the least tip error at the goal; within 10 % of it, the Jacobian renewed most often
+        # (a W matrix's age is its risk: a stale one can let a stiff mode grow)
+        least = min(c[0] for c in fast)
+        near = [c for c in fast if c[0] <= 1.1 * least]
+        pick = min(near, key=lambda c: (ros2_setting(c[1])[1] if parse(c[1])[1] == "ROS2"
+                                        else 0, -c[2]))
+        verdict += ("\n\nTraining choice (`boom_env` fidelity \"train\", "
+                    "boom_env.full_physics.FIDELITIES): among the cases at a real-time factor "
+                    f">= {RTF_GOAL * (1 + ENV_MARGIN):g} (CPU; the goal {RTF_GOAL:g} with a "
+                    f"margin of {100 * ENV_MARGIN:.0f} % for the v1 env's plant, whose oil "
+                    "column and hoist rope this scene lacks) the least tip error, and within "
+                    "10 % of it the "
+                    "Jacobian renewed most often (a W matrix's age is its risk: a stale one can "
+                    f"let a stiff mode grow): `{pick[1]}`, real-time factor {pick[2]:.2f} (CPU), "
+                    f"tip error {pick[0]:.1e} m ({pick[3]:.1e} m root mean square), force error "
+                    f"{pick[4]:.1e} of the range (its median over the step ends "
+                    f"{median_force(results[pick[1]], ref):.1e}: the largest errors are the "
+                    "force's stick-slip swings, whose pattern the relaxed stick band changes).  "
+                    "Cases above that speed: "
+                    + "; ".join(f"`{c[1]}` {c[2]:.2f}, tip {c[0]:.1e} m"
+                                for c in sorted(fast)) + ".")
     reading = []
     for n in sorted({parse(c)[0] for c in cases}):
         rk = [results[c] for c in cases if parse(c)[:2] == (n, "RK45") and "n_steps" in results[c]
@@ -464,18 +424,23 @@ def main():
         t_rhs = rk["cpu_s"] / rk["n_rhs"] if rk.get("n_rhs") else 1e-3
         per = (f"{1e3 * t_rhs:.2f} ms of CPU (`n3-RK45-1e-6`: its CPU seconds over its "
                "right-hand sides)" if rk.get("n_rhs") else "about 1 ms")
-        notes += ["", "The integrator that would pay: at 3 nodes a right-hand side costs "
+        notes += ["", "The integrator that pays: at 3 nodes a right-hand side costs "
                   + per + f", so a real-time factor of {RTF_GOAL:g} leaves about "
                   f"{DT / RTF_GOAL / t_rhs:.0f} right-hand sides per control step of {DT:g} "
-                  "s, Jacobians included (one costs ~18); only a linearly "
+                  "s, Jacobians included (one costs ~20); only a linearly "
                   "implicit method at the control step fits.  ROS2: "
-                  + "; ".join(cell(c) for c in ros) + ".  Its large steps do not resolve the "
-                  "friction law's stick band (near stick the regularised law is a damper "
-                  "mu_s N / v_eps, on its falling branch unstable with growth times of a few "
-                  "ms; docs/model.md, Time integration): the cylinder force spikes at breakaway "
-                  "and sticking, and the tip's error is centimetres, of the order of the "
-                  "deflection itself, even with a new Jacobian at every control step (at 9 "
-                  "nodes, where the mesh is converged, the error is ROS2's own)."]
+                  + "; ".join(cell(c) for c in ros) + ".  With a fresh Jacobian at every "
+                  "control step its error on the 3-node mesh is the mesh's own (`n3-RK45-1e-4` "
+                  "above); on the paper's mesh (9 nodes) it is ROS2's: first order between "
+                  "renewals (the friction law is only C0 at v_eps, and the stiff modes' "
+                  "forcing enters through a df/dt renewed with the Jacobian; sim_core."
+                  "integrate.rosenbrock).  Its W matrix leaves out the friction law's falling "
+                  "branch: with it, the branch's growth rate (~10 1/s) meets ROS2's pole at "
+                  "h lambda = 1/gamma = 0.59 and a stage behind the oil column runs away "
+                  "(docs/model.md, Time integration).  Renewing the Jacobian every tenth or "
+                  "twentieth control step reaches the goal (the spread of the clocks above is "
+                  "up to a third); a failed case says where a stale one let a "
+                  "stiff mode grow."]
     rel = [c for c in cases if relaxed(c)[1] and "cpu_s" in results[c]]
     if rel:
         def cell2(c):
@@ -493,7 +458,7 @@ def main():
                               f"against {results[b]['n_rhs']} / {results[b]['n_jacobians']}"
                               for c, b in base) + ".  The wider filter window cuts the "
                           "explicit method's steps, the wider stick band leaves ROS2's work as "
-                          "it is and its force spikes smaller.")
+                          "it is.")
         if "cpu_s" in results.get("n3-RK45-1e-4", {}):
             notes[-1] += ("  The tip's error of the 3-node mesh on the paper's model "
                           f"(`n3-RK45-1e-4`): {errors(results['n3-RK45-1e-4'], ref)[0]:.1e} m.")
@@ -508,14 +473,14 @@ def main():
                   f"({e[1]:.1e} m root mean square) on this episode."]
     if a.whole_process:
         notes += ["", "Whole process (`python benchmarks/training_fidelity.py --env-episode "
-                  "converged`: import, reset and one 600-step episode of "
-                  "`TelescopicBoomEnv(fidelity=\"converged\")`, timed from outside, pinned to core "
+                  "FIDELITY --env-id ENV`: import, reset and one 600-step episode of the env "
+                  "on the cubic schedule, timed from outside with farm-bench, pinned to core "
                   f"0): {a.whole_process}"]
     lines = ["# Training fidelity of the full model: mesh, tolerance and integrator", "",
              "Written by `benchmarks/training_fidelity.py` (its docstring describes the episode, "
              "the cases and the errors).  The paper's extraction over 30 s with friction, "
              "stepped as `boom_env` steps it (control step 0.05 s, each step a fresh "
-             "integration); every case in a child process pinned to core 0 "
+             "integration; ROS2 keeps its Jacobian from step to step); every case in a child process pinned to core 0 "
              "(`taskset -c 0`), one after the other.  Wall and CPU: the 600 steps and the tip "
              "reads (real-time factor = 30 s / wall, or / CPU seconds of the child); reset: "
              "the build and the static equilibrium.  Errors against the reference "

@@ -53,7 +53,7 @@ Fidelity (``fidelity``)
 -----------------------
 * ``"rl"`` (default): the batched ROM above (one compiled call per step for all cranes of the
   native vector env; env steps per second on one core: benchmarks/results/vector_env_speed.md).
-* ``"paper"``, ``"converged"``: the full sim_core model with the payload on its hoist rope
+* ``"paper"``, ``"converged"``, ``"train"``: the full sim_core model with the payload on its hoist rope
   (``boom_env.full_physics.FullPhysicsPlant``, its fidelities; the scene's 500 kg hook hangs
   with the payload, the rope's unstretched length is the loaded ``rope_length`` over
   1 + m g / EA) driven along the piston kinematics.  With ``friction=True`` the full model's
@@ -63,8 +63,10 @@ Fidelity (``fidelity``)
   its stages stick and slip behind the piston as the ROM's do; the observed L_s, its rate and
   the applied acceleration are then its stages' (``info["stuck"]``: their rate within the
   friction law's stick band, |L_s'| < v_eps = 0.01 m/s).  ``friction=False``: the stages
-  follow the piston exactly.  The scalar env only; slow (a few env steps per second): for
-  checking policies.
+  follow the piston exactly.  The scalar env only.  ``"paper"`` and ``"converged"`` are slow
+  (a few env steps per second): for checking policies; ``"train"`` (the coarse mesh, ROS2 at
+  the control step and the relaxed regularisations of ``boom_env.full_physics.FIDELITIES``)
+  runs about ten times faster than real time, for fine-tuning on the full model.
 
 Action space
 ------------
@@ -176,7 +178,8 @@ Version history
   "converged" (full model, scalar env); render exaggeration 20x.  The full-model fidelities
   with friction drive the stages through the cylinder's oil column, as the ROM does (before,
   the full model's stages followed the piston exactly while the ROM's stuck and slipped).
-  Option ``friction_law="regularised"`` (the default ``"coulomb"`` unchanged).
+  Option ``friction_law="regularised"`` (the default ``"coulomb"`` unchanged); fidelity
+  ``"train"`` (additive).
 * v0: ``boom_env.telescopic_env`` (payload fixed at the tip; its own version history).
 """
 
@@ -212,7 +215,7 @@ REFS = {3: {"d_ref": 0.05, "dv_ref": 0.08, "sway_ref": 0.05, "sway_rate_ref": 0.
 G = 9.81
 RESET_OPTIONS = ("payload", "luffing_angle_deg", "rope_length", "stroke_start",
                  "stroke_target", "sway")
-FIDELITIES = ("rl", "paper", "converged")
+FIDELITIES = ("rl", "paper", "converged", "train")
 HOIST_EA, HOOK_MASS = 2e8, 500.0             # N, kg: the crane scenes' hoist rope and hook
 
 

@@ -204,6 +204,9 @@ PATHS = {   # (scene, overrides, checkpoints before the stop, their interval s)
     "RK45": (BEAM[0], {**dict(a.split("=", 1) for a in BEAM[2::2]), "solver.t_end": "0.004",
                        "solver.method": "RK45"}, 60, 1e-9),
     "BDF": ("folding_boom", {"solver.t_end": "0.5", "solver.n_output": "11"}, 5, 1e-9),
+    "ROS2": ("telescopic_extraction", {"booms.n_nodes": "3", "solver.method": "ROS2",
+                                       "solver.t_end": "1.0", "solver.n_output": "21",
+                                       "solver.jacobian_interval": "0.3"}, 7, 1e-9),
 }
 
 

@@ -51,11 +51,15 @@ def test_a_command_drives_the_stages_on_its_acceleration():
     assert (pos - 2.0, rate, acc) == pytest.approx((s, a1 * T1 + a2 * T2, a2), abs=1e-12)
 
 
-def test_restored_state_repeats_the_run():
+@pytest.mark.parametrize("solver", [{}, {"solver.method": "ROS2", "solver.jacobian_interval": 0.1}],
+                         ids=["RK45", "ROS2"])
+def test_restored_state_repeats_the_run(solver):
     """save_state after three commanded steps, four more steps; restore (through pickle) and
     the same four steps give the same state bit for bit: the snapshot holds the time, the
-    integrated state, every drive's segment and the friction's warm starts."""
-    sc = load_scene("telescopic_extraction", overrides={**FAST, "effects.friction": True})
+    integrated state, every drive's segment and the friction's warm starts (with ROS2 also its
+    Jacobian, renewed inside the four steps)."""
+    sc = load_scene("telescopic_extraction", overrides={**FAST, "effects.friction": True,
+                                                        **solver})
     sim = Simulation(sc)
     for _ in range(3):
         sim.advance(0.05, {"telescopic": 0.2})

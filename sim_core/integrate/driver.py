@@ -23,11 +23,12 @@ from sim_core.integrate.bdf import (
 )
 from sim_core.integrate.checks import check_result, result_checks
 from sim_core.integrate.generalized_alpha import GeneralizedAlphaParameters, integrate_generalized_alpha
+from sim_core.integrate.rosenbrock import RosenbrockW2
 from sim_core.integrate.switching import MethodSwitch
 from sim_core.model.model import Model
 from sim_core.model.state_jacobian import REL_STEP, state_jacobian
 from sim_core.physics import _effects_numba as ec
-from sim_core.scene.fields import SOLVER_METHODS
+from sim_core.scene.fields import INTEGRATORS
 
 
 class _CountingRHS:
@@ -201,6 +202,9 @@ def integrate(model, y0: np.ndarray, t_end: float, sol: dict, progress=None, che
       error-controlled by rtol/atol, or at the fixed step ``sol["h"]`` where given — for beam
       models without friction switching, where the explicit step is stability-limited by the
       stiffest bending mode;
+    * ``"ROS2"``: the Rosenbrock-W method at the fixed step ``sol["h"]`` with the structured
+      Jacobian renewed every ``sol["jacobian_interval"]`` s (:func:`integrate_ros2`) — the
+      training integrator: few right-hand sides per step, error not controlled;
     * ``"auto"``: RK45 and BDF alternate as :class:`MethodSwitch` decides (RK45 -> BDF when
       :class:`StiffnessDetector` finds the step stability-limited, back to RK45 after a
       stretch whose length adapts to which method was cheaper; with a model's
@@ -224,10 +228,12 @@ def integrate(model, y0: np.ndarray, t_end: float, sol: dict, progress=None, che
     switch, the stall monitor, the counters, the outputs so far and the model's warm
     starts), so a resumed run takes the same steps and its result is bit-identical."""
     method = sol.get("method", "RK45")
-    if method not in SOLVER_METHODS:
-        raise ValueError(f"solver.method = {method!r}: must be one of {SOLVER_METHODS}")
+    if method not in INTEGRATORS:
+        raise ValueError(f"solver.method = {method!r}: must be one of {INTEGRATORS}")
     if method == "generalized_alpha":
         return integrate_alpha(model, y0, t_end, sol, progress, checkpoint)
+    if method == "ROS2":
+        return integrate_ros2(model, y0, t_end, sol, progress, checkpoint)
     t_eval = np.linspace(0.0, t_end, sol["n_output"])
     rhs = _CountingRHS(model)
     kwargs = {"max_step": sol["max_step"]} if "max_step" in sol else {}
@@ -646,6 +652,57 @@ def _alpha_fixed(model, y0: np.ndarray, t_end: float, sol: dict, progress=None,
                 "q": q, "v": v, "qdd": qdd, "a": a, "Sinv": Sinv, "qdd_prev": qdd_prev,
                 "carry": carry, "out": out, "counts": counts, "ys": np.array(ys),
                 "h_used": list(h_used), "k": k + 1, "wall_s": time.perf_counter() - wall0})
+    return t_eval, np.array(ys), stats()
+
+
+def integrate_ros2(model, y0: np.ndarray, t_end: float, sol: dict, progress=None,
+                   checkpoint=None):
+    """ROS2 (:class:`sim_core.integrate.rosenbrock.RosenbrockW2`) at the fixed step
+    ``sol["h"]``: each output interval in equal steps of at most h, the Jacobian renewed every
+    ``sol["jacobian_interval"]`` s; the wall budget and checkpoints after whole output
+    intervals (a resumed run takes the same steps with the same Jacobian)."""
+    t_eval = np.linspace(0.0, t_end, sol["n_output"])
+    budget = sol.get("max_wall_s")
+    wall0 = time.perf_counter()
+    ros = RosenbrockW2(model, float(sol["h"]), float(sol["jacobian_interval"]))
+    ys, k0 = [np.array(y0, dtype=float)], 1
+    saved = checkpoint.take("ros2") if checkpoint is not None else None
+    if saved is not None:
+        ys, k0 = list(saved["ys"]), int(saved["k"])
+        ros.restore(saved["ros2"])
+        restore_warm_starts(model, saved["warm"])
+        wall0 = time.perf_counter() - float(saved["wall_s"])
+
+    def stats():
+        wall = time.perf_counter() - wall0
+        return {"wall_time_s": wall, **ros.stats, "method": "ROS2", "h": ros.h,
+                "jacobian_interval": ros.interval,
+                "real_time_factor": float(t_eval[len(ys) - 1]) / max(wall, 1e-12),
+                **(checkpoint.stats() if checkpoint is not None else {})}
+
+    def fail(exc: SimulationError) -> SimulationError:
+        exc.partial = (t_eval[:len(ys)], np.array(ys), stats())
+        return exc
+
+    for k in range(k0, len(t_eval)):
+        try:
+            ys.append(ros.advance(float(t_eval[k - 1]), ys[-1], float(t_eval[k] - t_eval[k - 1])))
+        except SimulationError as exc:
+            raise fail(exc) from None
+        except KeyboardInterrupt:
+            raise fail(SimulationError(float(t_eval[k - 1]), "interrupted by the user "
+                                       "(KeyboardInterrupt)", step=ros.h,
+                                       last_state=ys[-1])) from None
+        if progress is not None:
+            progress(float(t_eval[k]), time.perf_counter() - wall0)
+        if budget is not None and time.perf_counter() - wall0 > budget and k < len(t_eval) - 1:
+            raise fail(SimulationError(float(t_eval[k]), "wall-clock budget solver.max_wall_s "
+                                       f"= {budget:g} s exhausted", step=ros.h,
+                                       last_state=ys[-1]))
+        if checkpoint is not None and k < len(t_eval) - 1 and checkpoint.due():
+            checkpoint.save("ros2", float(t_eval[k]), {
+                "ys": np.array(ys), "k": k + 1, "ros2": ros.state(), "warm": warm_starts(model),
+                "wall_s": time.perf_counter() - wall0})
     return t_eval, np.array(ys), stats()
 
 

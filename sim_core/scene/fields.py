@@ -462,8 +462,12 @@ def read_text(raw: dict, table: Table, sc: dict, name_default: str) -> None:
 # -- the solver table (all scene kinds) ----------------------------------------------------------
 
 SOLVER_METHODS = ("RK45", "BDF", "auto", "generalized_alpha")
+#: every method the driver knows: SOLVER_METHODS (the default of a scene kind) and the
+#: Rosenbrock-W training integrator "ROS2", which a kind offers by name (the telescopic one)
+INTEGRATORS = SOLVER_METHODS + ("ROS2",)
 JACOBIANS = ("structured", "finite_difference")
 _ALPHA_KEYS = ("h", "h_max", "rho_inf", "newton_atol")
+_ROS2_KEYS = ("h", "jacobian_interval")
 # the methods with error control, the stiffness switch and the stall monitor: the only ones for
 # systems whose forces switch (friction stick-slip, contact) or that hold nonlinear constraints
 ERROR_CONTROLLED = ("RK45", "BDF", "auto")
@@ -483,7 +487,9 @@ def solver_fields(t_end=None, atol: float = 1e-8, n_output: int = 201,
               note="the integrator (sim_core.integrate.driver.integrate): \"RK45\" explicit, "
                    "\"BDF\" implicit for stiff runs, \"auto\" switches between the two"
                    + (", \"generalized_alpha\" implicit second-order for beams without "
-                      "switching forces" if "generalized_alpha" in methods else "")),
+                      "switching forces" if "generalized_alpha" in methods else "")
+                   + (", \"ROS2\" the Rosenbrock-W training integrator at a fixed step "
+                      "(sim_core.integrate.rosenbrock)" if "ROS2" in methods else "")),
         Field("jacobian", "choice", default="structured", choices=JACOBIANS,
               note="the implicit methods' Jacobian: \"structured\" by implicit "
                    "differentiation (sim_core.model.state_jacobian), \"finite_difference\" "
@@ -501,6 +507,17 @@ def solver_fields(t_end=None, atol: float = 1e-8, n_output: int = 201,
               note="wall-clock budget: the run stops there with a SimulationError and the "
                    "partial result"),
     ]
+    if "ROS2" in methods and "generalized_alpha" not in methods:
+        fields += [
+            Field("h", "number", "s", 0.05, lo=1e-4, hi=T_MAX,
+                  allowed="[1e-4 s, solver.t_end]", applies="method = \"ROS2\"",
+                  note="fixed step: each output interval (each Simulation.advance) cut into "
+                       "equal steps of at most h (rtol and atol then unused)"),
+            Field("jacobian_interval", "number", "s", 0.5, lo=0.0, hi=T_MAX,
+                  applies="method = \"ROS2\"",
+                  note="simulated time between fresh structured Jacobians (0: every step); "
+                       "a step across the friction law's slope band renews it at once"),
+        ]
     if "generalized_alpha" in methods:
         fields += [
             Field("h", "number", "s", OPTIONAL, lo=H_MIN, hi=T_MAX,
@@ -535,10 +552,15 @@ def solver_table(s: dict, t_end=None, atol: float = 1e-8, n_output: int = 201,
     if not isinstance(s, dict):
         raise SceneError(f"solver = {short_repr(s)}: must be a table ([solver])")
     for key in _ALPHA_KEYS:         # a generalized-alpha key in a kind without that method
-        if key in s and "generalized_alpha" not in methods:
+        if key in s and "generalized_alpha" not in methods and \
+                not (key in _ROS2_KEYS and "ROS2" in methods):
             raise SceneError(f"solver.{key} = {short_repr(s[key])}: only method = "
                              f"'generalized_alpha' has a {key}, which this scene kind does not "
                              f"take (allowed methods: {', '.join(methods)})")
+    if "jacobian_interval" in s and "ROS2" not in methods:
+        raise SceneError(f"solver.jacobian_interval = {short_repr(s['jacobian_interval'])}: "
+                         "only method = 'ROS2' has a jacobian_interval, which this scene kind "
+                         f"does not take (allowed methods: {', '.join(methods)})")
     T.check_keys(s, "solver")
     out = {"t_end": T.read(s, "t_end", "solver"),
            "method": T.read(s, "method", "solver"),
@@ -563,10 +585,20 @@ def solver_table(s: dict, t_end=None, atol: float = 1e-8, n_output: int = 201,
         out["rho_inf"] = T.read(s, "rho_inf", "solver")
         out["newton_atol"] = T.read(s, "newton_atol", "solver",
                                     default=1e-8 if "h" in out else 0.1 * out["atol"])
-    else:
+    elif out["method"] == "ROS2":
+        out["h"] = T.read(s, "h", "solver", hi=out["t_end"])
+        out["jacobian_interval"] = T.read(s, "jacobian_interval", "solver")
         for key in _ALPHA_KEYS:
-            if key in s:
+            if key in s and key not in _ROS2_KEYS:
                 raise SceneError(f"solver.{key} = {short_repr(s[key])}: only method = "
-                                 f"'generalized_alpha' has a {key} (method is "
-                                 f"{out['method']!r})")
+                                 f"'generalized_alpha' has a {key} (method is 'ROS2')")
+    else:
+        for key in _ALPHA_KEYS + _ROS2_KEYS:
+            if key in s:
+                owner = " or ".join(f"'{m}'" for m, keys in (("generalized_alpha",
+                                                               _ALPHA_KEYS),
+                                                              ("ROS2", _ROS2_KEYS))
+                                    if m in methods and key in keys)
+                raise SceneError(f"solver.{key} = {short_repr(s[key])}: only method = "
+                                 f"{owner} has a {key} (method is {out['method']!r})")
     return out

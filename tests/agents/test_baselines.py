@@ -87,13 +87,15 @@ def test_quick_all_rows(tmp_path):
         assert all(np.isfinite(r["returns"]).all() for r in rec["seeds"].values())
 
 
-def test_full_physics_column_runs_the_v1_task_on_the_full_model():
-    """The transfer column's episodes: the v1 env at fidelity FULL_FIDELITY, reset with the
-    evaluation seed (the ROM column's payload and angle), the policy acting on the full
-    model's observation; the returns equal a direct run of the scalar env (shortened to 1 s)."""
+@pytest.mark.parametrize("fidelity", [B.FULL_FIDELITY, B.TRAIN_FIDELITY])
+def test_full_physics_column_runs_the_v1_task_on_the_full_model(fidelity):
+    """The transfer column's and the training-fidelity column's episodes: the v1 env at the
+    fidelity, reset with the evaluation seed (the ROM column's payload and angle), the policy
+    acting on the full model's observation; the returns equal a direct run of the scalar env
+    (shortened to 1 s)."""
     seed, kw = B.eval_seed(0), dict(t_max=1.0)
-    got = B.full_physics_returns(B.scripted_actor("cubic"), seed, 1, **kw)
-    env = gym.make(B.ENV_ID, fidelity=B.FULL_FIDELITY, **B.env_kwargs(**kw))
+    got = B.full_physics_returns(B.scripted_actor("cubic"), seed, 1, None, fidelity, **kw)
+    env = gym.make(B.ENV_ID, fidelity=fidelity, **B.env_kwargs(**kw))
     _, info0 = env.reset(seed=seed)
     acts = B.schedule_actions("cubic")
     total, k, done = 0.0, 0, False
@@ -102,7 +104,7 @@ def test_full_physics_column_runs_the_v1_task_on_the_full_model():
         total += r
         done = term or trunc
         k += 1
-    assert k == 20 and info["fidelity"] == B.FULL_FIDELITY and not info["diverged"]
+    assert k == 20 and info["fidelity"] == fidelity and not info["diverged"]
     assert got == [total]
     rom = gym.make(B.ENV_ID, **B.env_kwargs(**kw))
     _, rinfo = rom.reset(seed=seed)

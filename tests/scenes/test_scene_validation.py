@@ -275,6 +275,33 @@ def test_one_solver_table_for_every_scene_kind(scene):
     assert_names(err({"solver.rtol": 1.0}, scene), "solver.rtol", "[1e-12, 0.1]")
 
 
+def test_ros2_keys_of_the_telescopic_kind():
+    """solver.method = "ROS2" (the telescopic kind only) reads its fixed step h (default 0.05 s,
+    at most t_end) and jacobian_interval (default 0.5 s, >= 0); the two keys are refused with
+    another method, and by kinds without the method; the generalized-alpha keys stay refused."""
+    tel = "telescopic_extraction"
+    s = load_scene(tel, overrides={"solver.method": "ROS2"})["solver"]
+    assert (s["h"], s["jacobian_interval"]) == (0.05, 0.5)
+    s = load_scene(tel, overrides={"solver.method": "ROS2", "solver.h": 0.02,
+                                   "solver.jacobian_interval": 0.0})["solver"]
+    assert (s["h"], s["jacobian_interval"]) == (0.02, 0.0)
+    t_end = load_scene(tel)["solver"]["t_end"]
+    assert_names(err({"solver.method": "ROS2", "solver.h": 2 * t_end}, tel), "solver.h",
+                 f"{t_end:g}")
+    assert_names(err({"solver.method": "ROS2", "solver.h": 1e-6}, tel), "solver.h", "[0.0001, ")
+    assert_names(err({"solver.method": "ROS2", "solver.jacobian_interval": -1.0}, tel),
+                 "solver.jacobian_interval", "-1")
+    assert_names(err({"solver.jacobian_interval": 0.5}, tel), "solver.jacobian_interval",
+                 "only method = 'ROS2'", "'auto'")
+    assert_names(err({"solver.h": 0.05}, tel), "solver.h", "'ROS2'", "'auto'")
+    assert_names(err({"solver.method": "ROS2", "solver.rho_inf": 0.5}, tel), "solver.rho_inf",
+                 "generalized_alpha")
+    for other in ("beam_through_sleeve", "folding_boom"):
+        assert_names(err({"solver.method": "ROS2"}, other), "solver.method", "'ROS2'")
+        assert_names(err({"solver.jacobian_interval": 0.5}, other), "solver.jacobian_interval",
+                     "only method = 'ROS2'")
+
+
 @pytest.mark.parametrize("key, field", [("effects.gravity", "effects.gravity"),
                                         ("initial.static_equilibrium", "initial.static_equilibrium")])
 def test_boolean_field(key, field):
@@ -708,6 +735,7 @@ CONTEXTS = {
                                "effects.contact_distribution": False}),
         ("telescopic_extraction_rl", {}),
         ("telescopic_extraction", {"effects.oil_column": True}),
+        ("telescopic_extraction", {"solver.method": "ROS2"}),
     ],
     "folding": [("folding_boom", {})],
 }

@@ -63,7 +63,9 @@ TOP = Table("", (Field("kind", "choice", choices=("telescopic",)), *text_fields(
             tables=("solver", "booms", "boom", "luffing", "drive", "payload", "ropes",
                     "effects", "contact", "overlap", "filtering", "gravity", "luffing_drive",
                     "slew_drive", "hoist_drive", "hoist", "oil_column", "model"))
-SOLVER = solver_fields(t_end=20.0, atol=1e-7, methods=ERROR_CONTROLLED)
+#: the error-controlled methods and the Rosenbrock-W training integrator (fixed step)
+TELESCOPIC_METHODS = ERROR_CONTROLLED + ("ROS2",)
+SOLVER = solver_fields(t_end=20.0, atol=1e-7, methods=TELESCOPIC_METHODS)
 BOOMS = Table("booms", (
     Field("count", "integer", "", COMPUTED, lo=2, hi=MAX_BOOMS,
           default_text="3, or the number of [[boom]] tables",
@@ -440,7 +442,7 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
     read_text(raw, TOP, sc, "telescopic")
     sc["source"] = source
     sc["solver"] = solver_table(table_of(raw, "solver", ""), t_end=20.0, atol=1e-7,
-                                methods=ERROR_CONTROLLED)
+                                methods=TELESCOPIC_METHODS)
     b = table_of(raw, "booms", "")
     BOOMS.check_keys(b, "booms")
     boom_tables = tables_of(raw, "boom")

@@ -8,7 +8,9 @@ Two steppers, chosen by the scene's ``model.reduction``:
   payload swings) is a :class:`Drive`: it follows its scene profile until a command takes it
   over.  Each ``advance`` integrates the model over [t, t + dt] with the scene's solver
   settings; the model's drives read the time relative to the step's start (a clock the stepper
-  moves), so the integrator starts at 0 for every step.
+  moves), so the integrator starts at 0 for every step.  With ``solver.method = "ROS2"`` one
+  :class:`sim_core.integrate.rosenbrock.RosenbrockW2` serves every step and keeps its Jacobian
+  from step to step (part of the saved state).
 * ``"modal"`` (:class:`ModalStepper`): the stroke-parametric modal ROM
   (:mod:`sim_core.systems.telescopic.modal`) of the scene's crane, payload and luffing angle;
   one actuator, the telescopic stroke L_s.  Without a command it follows the scene's drive
@@ -37,7 +39,7 @@ import math
 import numpy as np
 
 from sim_core.commands import Command
-from sim_core.errors import SceneError
+from sim_core.errors import SceneError, SimulationError
 from sim_core.physics.drive_profiles import MotionSample
 
 #: the command names of the actuators, in the scene's tables
@@ -154,6 +156,12 @@ class TelescopicStepper:
         self.sol = {k: v for k, v in scene["solver"].items()
                     if k in ("rtol", "atol", "method", "jacobian", "max_step")}
         self.sol["n_output"] = 2
+        #: ROS2 keeps its Jacobian from one advance to the next (its jacobian_interval)
+        self.ros2 = None
+        if self.sol["method"] == "ROS2":
+            from sim_core.integrate.rosenbrock import RosenbrockW2
+            self.ros2 = RosenbrockW2(ts.model, scene["solver"]["h"],
+                                     scene["solver"]["jacobian_interval"])
         #: the integrations' work so far: accepted steps, right-hand sides, Jacobians
         self.stats = {"n_steps": 0, "n_rhs": 0, "n_jacobians": 0}
         m = ts.model
@@ -190,10 +198,16 @@ class TelescopicStepper:
         for name, cmd in _check_commands(commands, self.drives).items():
             self.drives[name].command(self.t, cmd)
         self.clock[0] = self.t
-        _, ys, st = integrate(self.ts.model, self.y, dt, self.sol)
-        for k in self.stats:
-            self.stats[k] += int(st.get(k, 0))
-        self.y = np.asarray(ys[-1], dtype=float)
+        if self.ros2 is not None:
+            before = dict(self.ros2.stats)
+            self.y = self.ros2.advance(0.0, self.y, dt, t_report=self.t)
+            for k in self.stats:
+                self.stats[k] += self.ros2.stats[k] - before[k]
+        else:
+            _, ys, st = integrate(self.ts.model, self.y, dt, self.sol)
+            for k in self.stats:
+                self.stats[k] += int(st.get(k, 0))
+            self.y = np.asarray(ys[-1], dtype=float)
         self.t += dt
         for d in self.drives.values():
             d.settle(self.t)
@@ -209,7 +223,13 @@ class TelescopicStepper:
         clock = self.clock[0]
         self.clock[0] = self.t
         try:
-            res = _telescopic_result(self.ts, np.array([0.0]), [self.y], {}, None, self.scene)
+            try:
+                res = _telescopic_result(self.ts, np.array([0.0]), [self.y], {}, None,
+                                         self.scene)
+            except (ArithmeticError, np.linalg.LinAlgError, ValueError) as exc:
+                raise SimulationError(self.t, "the model's solve failed at the current state "
+                                      f"({type(exc).__name__}: {exc})",
+                                      last_state=self.y) from None
             out = {k: np.asarray(res[k])[0] for k in res.keys() if k != "state"}
             out.update(self._light((("payload_velocity", "sway_rate")
                                     if self.ts.hoist is not None else ())
@@ -294,7 +314,9 @@ class TelescopicStepper:
         return {"t": self.t, "y": self.y.copy(),
                 "drives": {k: d.plan for k, d in self.drives.items()},
                 "friction_warm": copy.deepcopy(getattr(contact, "_x0", None)),
-                "model_warm": copy.deepcopy(self.ts.model.__dict__.get("_g_warm"))}
+                "model_warm": copy.deepcopy(self.ts.model.__dict__.get("_g_warm")),
+                "ros2": self.ros2.state() if self.ros2 is not None else None,
+                "stats": dict(self.stats)}
 
     def restore_state(self, state: dict) -> None:
         self.t = float(state["t"])
@@ -305,6 +327,10 @@ class TelescopicStepper:
             self.ts.contact._x0 = copy.deepcopy(state["friction_warm"])
         if state.get("model_warm") is not None:
             self.ts.model.__dict__["_g_warm"] = copy.deepcopy(state["model_warm"])
+        if self.ros2 is not None and state.get("ros2") is not None:
+            self.ros2.restore(state["ros2"])
+        if state.get("stats") is not None:
+            self.stats = dict(state["stats"])
 
 
 class ModalStepper:
