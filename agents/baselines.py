@@ -480,6 +480,8 @@ def add_full(row: str, seed: int, rec: dict, full_episodes: int, runs: Path) -> 
         have = list(rec.get(f"{key}_returns") or [])
         if full_episodes <= len(have):
             continue
+        # a fresh actor per plant: the random row's draws then repeat, so both plants see the
+        # same actions on the same episodes
         act = actor_for(row, seed, rec if row in TRAINED else None)
         meta = None
         if row == "ppo_residual":

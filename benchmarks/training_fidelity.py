@@ -173,7 +173,6 @@ def run_child(case: str, t_end: float, path: str) -> None:
     n = int(round(t_end / DT))
     tips, forces, strokes = [], [], []
     rom = case == "rom"
-    advance, stats = sim.advance, (lambda: sim.stats)
 
     def record():
         if rom:
@@ -192,7 +191,7 @@ def run_child(case: str, t_end: float, path: str) -> None:
     for _ in range(n):
         w0, c0 = time.perf_counter(), time.process_time()
         try:
-            advance(DT)
+            sim.advance(DT)
             sim.outputs(("tip_position", "tip_velocity"))    # what the env reads per step
             wall += time.perf_counter() - w0
             cpu += time.process_time() - c0
@@ -203,7 +202,7 @@ def run_child(case: str, t_end: float, path: str) -> None:
             return
     with open(path, "w") as f:
         json.dump({"case": case, "reset_s": reset, "wall_s": wall, "cpu_s": cpu,
-                   "t_end": t_end, **stats(),
+                   "t_end": t_end, **sim.stats,
                    "n_dof": 0 if rom else int(sim.system.model.n_dof),
                    "tip": np.asarray(tips).tolist(), "force": forces, "stroke": strokes}, f)
 
@@ -232,15 +231,13 @@ def errors(res: dict, ref: dict) -> tuple[float, float, float]:
     tip, tref = np.asarray(res["tip"]), np.asarray(ref["tip"])
     d, dref = tip - tip[0], tref - tref[0]
     e = np.hypot(*(d - dref)[:, [0, 2]].T)
-    F, Fref = np.asarray(res["force"]), np.asarray(ref["force"])
-    e_F = float(np.max(np.abs(F - Fref)) / (Fref.max() - Fref.min()))
-    return float(e.max()), float(np.sqrt(np.mean(e * e))), e_F
+    return float(e.max()), float(np.sqrt(np.mean(e * e))), float(np.max(force_errors(res, ref)))
 
 
-def median_force(res: dict, ref: dict) -> float:
-    """The median |F - F_ref| over the step ends, over the reference force's range."""
+def force_errors(res: dict, ref: dict) -> np.ndarray:
+    """|F - F_ref| at the step ends over the reference force's range."""
     F, Fref = np.asarray(res["force"]), np.asarray(ref["force"])
-    return float(np.median(np.abs(F - Fref)) / (Fref.max() - Fref.min()))
+    return np.abs(F - Fref) / (Fref.max() - Fref.min())
 
 
 def deflection(res: dict) -> float:
@@ -263,17 +260,16 @@ def env_episode(fidelity: str, env_id: str = "boom_env/TelescopicExtraction-v0")
     import gymnasium as gym
 
     import boom_env  # noqa: F401
-    from sim_core.profiles import CubicSmoothstepSchedule
+    from agents.schedules import cubic
     env = gym.make(env_id, fidelity=fidelity)
     env.reset(seed=0)
     base = env.unwrapped
     a_max = float(np.ravel(getattr(base, "a_max", None) or base.core.a_max)[0])
-    sched = CubicSmoothstepSchedule(v_max=0.5, t_ramp=4.0, t_hold_end=12.0, s0=2.0)
     n = int(round(T_END / DT))
+    actions = cubic().actions(DT, a_max, n)
     w0 = time.perf_counter()
-    for k in range(n):
-        a = (sched.rate((k + 1) * DT) - sched.rate(k * DT)) / DT
-        *_, term, trunc, info = env.step(np.array([a / a_max], np.float32))
+    for a in actions:
+        *_, term, trunc, info = env.step(np.array([a], np.float32))
         if info.get("diverged"):
             raise RuntimeError(info["reason"])
         if term or trunc:
@@ -388,7 +384,7 @@ def main():
                     f"let a stiff mode grow): `{pick[1]}`, real-time factor {pick[2]:.2f} (CPU), "
                     f"tip error {pick[0]:.1e} m ({pick[3]:.1e} m root mean square), force error "
                     f"{pick[4]:.1e} of the range (its median over the step ends "
-                    f"{median_force(results[pick[1]], ref):.1e}: the largest errors are the "
+                    f"{float(np.median(force_errors(results[pick[1]], ref))):.1e}: the largest errors are the "
                     "force's stick-slip swings, whose pattern the relaxed stick band changes).  "
                     "Cases above that speed: "
                     + "; ".join(f"`{c[1]}` {c[2]:.2f}, tip {c[0]:.1e} m"

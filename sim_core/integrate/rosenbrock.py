@@ -55,6 +55,13 @@ GAMMA = 1.0 + 1.0 / math.sqrt(2.0)      # Verwer et al. 1999, Eq. 2.2
 B1, B2 = 1.5, 0.5                       # y1 = y + h (B1 k1 + B2 k2)
 MAX_HALVINGS = 3                        # a repeated step is halved at most this often
 FT_STEP = 1e-6                          # s, the difference step of df/dt
+#: what a failed model solve raises under _raise_fp (scipy's finite check raises ValueError)
+_SOLVE_FAILURES = (ArithmeticError, np.linalg.LinAlgError, ValueError, SimulationError)
+
+
+def _raise_fp():
+    """Floating-point overflow, division by zero and invalid results raise (underflow not)."""
+    return np.errstate(over="raise", divide="raise", invalid="raise", under="ignore")
 
 
 @contextlib.contextmanager
@@ -119,9 +126,9 @@ class RosenbrockW2:
         """f(t, y), or None where the model's solve fails or the result is not finite."""
         self.stats["n_rhs"] += 1
         try:
-            with np.errstate(over="raise", divide="raise", invalid="raise", under="ignore"):
+            with _raise_fp():
                 f = self.model.rhs(t, y)
-        except (ArithmeticError, np.linalg.LinAlgError, ValueError, SimulationError):
+        except _SOLVE_FAILURES:
             return None
         return f if np.all(np.isfinite(f)) else None
 
@@ -131,10 +138,9 @@ class RosenbrockW2:
         the time derivative df/dt (a forward difference over FT_STEP from f = f(t, y))."""
         n = self.n
         try:
-            with monotone_friction(self.model), \
-                    np.errstate(over="raise", divide="raise", invalid="raise", under="ignore"):
+            with monotone_friction(self.model), _raise_fp():
                 J = self._jacobian(self.model, t, y)
-        except (ArithmeticError, np.linalg.LinAlgError, ValueError, SimulationError) as exc:
+        except _SOLVE_FAILURES as exc:
             raise SimulationError(self._t_fail + t, "ROS2: the Jacobian failed "
                                   f"({type(exc).__name__}: {exc})", step=self.h,
                                   last_state=y) from None

@@ -466,8 +466,9 @@ SOLVER_METHODS = ("RK45", "BDF", "auto", "generalized_alpha")
 #: Rosenbrock-W training integrator "ROS2", which a kind offers by name (the telescopic one)
 INTEGRATORS = SOLVER_METHODS + ("ROS2",)
 JACOBIANS = ("structured", "finite_difference")
-_ALPHA_KEYS = ("h", "h_max", "rho_inf", "newton_atol")
-_ROS2_KEYS = ("h", "jacobian_interval")
+#: the [solver] keys that only some methods take
+_METHOD_KEYS = {"generalized_alpha": ("h", "h_max", "rho_inf", "newton_atol"),
+                "ROS2": ("h", "jacobian_interval")}
 # the methods with error control, the stiffness switch and the stall monitor: the only ones for
 # systems whose forces switch (friction stick-slip, contact) or that hold nonlinear constraints
 ERROR_CONTROLLED = ("RK45", "BDF", "auto")
@@ -551,16 +552,12 @@ def solver_table(s: dict, t_end=None, atol: float = 1e-8, n_output: int = 201,
     T = solver_fields(t_end, atol, n_output, methods, method)
     if not isinstance(s, dict):
         raise SceneError(f"solver = {short_repr(s)}: must be a table ([solver])")
-    for key in _ALPHA_KEYS:         # a generalized-alpha key in a kind without that method
-        if key in s and "generalized_alpha" not in methods and \
-                not (key in _ROS2_KEYS and "ROS2" in methods):
-            raise SceneError(f"solver.{key} = {short_repr(s[key])}: only method = "
-                             f"'generalized_alpha' has a {key}, which this scene kind does not "
-                             f"take (allowed methods: {', '.join(methods)})")
-    if "jacobian_interval" in s and "ROS2" not in methods:
-        raise SceneError(f"solver.jacobian_interval = {short_repr(s['jacobian_interval'])}: "
-                         "only method = 'ROS2' has a jacobian_interval, which this scene kind "
-                         f"does not take (allowed methods: {', '.join(methods)})")
+    for key in s:                   # a method's key in a kind without any method taking it
+        owners = _owners(key, INTEGRATORS)
+        if owners and not _owners(key, methods):
+            raise SceneError(f"solver.{key} = {short_repr(s[key])}: only method = {owners} has "
+                             f"a {key}, which this scene kind does not take (allowed methods: "
+                             f"{', '.join(methods)})")
     T.check_keys(s, "solver")
     out = {"t_end": T.read(s, "t_end", "solver"),
            "method": T.read(s, "method", "solver"),
@@ -572,6 +569,11 @@ def solver_table(s: dict, t_end=None, atol: float = 1e-8, n_output: int = 201,
         out["max_step"] = T.read(s, "max_step", "solver", hi=out["t_end"])
     if "max_wall_s" in s:
         out["max_wall_s"] = T.read(s, "max_wall_s", "solver")
+    for key in s:                   # a method's key with another method of the kind
+        owners = _owners(key, methods)
+        if owners and key not in _METHOD_KEYS.get(out["method"], ()):
+            raise SceneError(f"solver.{key} = {short_repr(s[key])}: only method = {owners} has "
+                             f"a {key} (method is {out['method']!r})")
     if out["method"] == "generalized_alpha":
         if "h" in s:
             out["h"] = T.read(s, "h", "solver", lo=max(H_MIN, out["t_end"] / MAX_FIXED_STEPS),
@@ -588,17 +590,10 @@ def solver_table(s: dict, t_end=None, atol: float = 1e-8, n_output: int = 201,
     elif out["method"] == "ROS2":
         out["h"] = T.read(s, "h", "solver", hi=out["t_end"])
         out["jacobian_interval"] = T.read(s, "jacobian_interval", "solver")
-        for key in _ALPHA_KEYS:
-            if key in s and key not in _ROS2_KEYS:
-                raise SceneError(f"solver.{key} = {short_repr(s[key])}: only method = "
-                                 f"'generalized_alpha' has a {key} (method is 'ROS2')")
-    else:
-        for key in _ALPHA_KEYS + _ROS2_KEYS:
-            if key in s:
-                owner = " or ".join(f"'{m}'" for m, keys in (("generalized_alpha",
-                                                               _ALPHA_KEYS),
-                                                              ("ROS2", _ROS2_KEYS))
-                                    if m in methods and key in keys)
-                raise SceneError(f"solver.{key} = {short_repr(s[key])}: only method = "
-                                 f"{owner} has a {key} (method is {out['method']!r})")
     return out
+
+
+def _owners(key: str, methods) -> str:
+    """The methods among ``methods`` that take the [solver] key ``key`` (_METHOD_KEYS), quoted
+    and joined by "or"; "" where none does."""
+    return " or ".join(f"'{m}'" for m in methods if key in _METHOD_KEYS.get(m, ()))

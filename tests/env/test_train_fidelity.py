@@ -7,17 +7,15 @@ import numpy as np
 import pytest
 
 import boom_env  # noqa: F401
+from agents.schedules import cubic
 from boom_env.full_physics import FIDELITIES, FullPhysicsPlant
-from sim_core.profiles import CubicSmoothstepSchedule
 
-CUBIC = CubicSmoothstepSchedule(v_max=0.5, t_ramp=4.0, t_hold_end=12.0, s0=2.0)
 DT = 0.05
 
 
-def cubic_action(k: int, a_max: float) -> np.ndarray:
-    """The cubic schedule's mean acceleration over control step k, as an action."""
-    a = (CUBIC.rate((k + 1) * DT) - CUBIC.rate(k * DT)) / DT
-    return np.array([a / a_max], np.float32)
+def cubic_actions(env, n: int) -> np.ndarray:
+    """The paper's cubic schedule as n actions of ``env`` (each step's mean acceleration)."""
+    return cubic().actions(DT, float(np.ravel(env.unwrapped.core.a_max)[0]), n)[:, None]
 
 
 def test_train_plant_has_the_chosen_settings():
@@ -62,18 +60,12 @@ def test_v1_train_episode_runs_and_renews_its_jacobian_as_set():
     import gymnasium as gym
     env = gym.make("boom_env/TelescopicExtraction-v1", fidelity="train")
     env.reset(seed=0)
-    base = env.unwrapped
-    a_max = float(np.ravel(base.core.a_max)[0])
-    k = 0
-    while True:
-        obs, r, term, trunc, info = env.step(cubic_action(k, a_max))
+    for k, a in enumerate(cubic_actions(env, 600)):
+        obs, r, term, trunc, info = env.step(a)
         assert np.all(np.isfinite(obs)) and np.isfinite(r)
         assert not info["diverged"], info["reason"]
-        k += 1
-        if term or trunc:
-            break
-    assert k == 600
-    st = base.core.plant.sim.stats
+        assert (term or trunc) == (k == 599)
+    st = env.unwrapped.core.plant.sim.stats
     every = round(30.0 / FIDELITIES["train"]["solver"]["jacobian_interval"])
     extra = st["n_steps"] - 600
     assert 0 <= extra < 60
@@ -93,10 +85,9 @@ def test_v1_train_follows_the_paper_accuracy_model_on_the_stroke_and_the_sway():
     envs = [gym.make("boom_env/TelescopicExtraction-v1", fidelity=f) for f in ("train", "paper")]
     for e in envs:
         e.reset(seed=0)
-    a_max = float(np.ravel(envs[0].unwrapped.core.a_max)[0])
     obs = []
-    for k in range(100):
-        obs.append([np.asarray(e.step(cubic_action(k, a_max))[0], float) for e in envs])
+    for a in cubic_actions(envs[0], 100):
+        obs.append([np.asarray(e.step(a)[0], float) for e in envs])
     obs = np.asarray(obs)                   # (step, fidelity, observation)
     assert np.max(np.abs(obs[:, 0, 0] - obs[:, 1, 0])) < 0.01
     sway = obs[:, :, 9]
