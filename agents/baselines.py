@@ -54,13 +54,15 @@ import glob
 import json
 import math
 import os
-import pickle
 import subprocess
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
+
+from .model_io import (convert_trusted_pickle, load_sb3, load_vecnorm, save_vecnorm,
+                       to_vecnormalize)
 
 ENV_ID = "boom_env/TelescopicExtraction-v1"
 #: the full model's fidelity of the transfer column (boom_env.full_physics.FIDELITIES: the
@@ -177,11 +179,10 @@ def sb3_actor(model_path, vecnorm_path=None, algo: str = "ppo"):
     """Deterministic actions of a saved SB3 model on raw observations (its VecNormalize
     observation statistics applied)."""
     from stable_baselines3 import PPO, SAC
-    model = (SAC if algo == "sac" else PPO).load(str(model_path), device="cpu")
+    model = load_sb3(SAC if algo == "sac" else PPO, model_path, device="cpu")
     vn = None
     if vecnorm_path is not None and Path(vecnorm_path).is_file():
-        with open(vecnorm_path, "rb") as f:
-            vn = pickle.load(f)
+        vn = load_vecnorm(vecnorm_path)
 
     def act(obs, k):
         o = np.asarray(obs, np.float32)
@@ -293,10 +294,10 @@ def train_ppo_vector(seed: int, steps: int, out: Path, quick: bool = False, **en
     wall = time.perf_counter() - t0
     model.save(str(out / "model.zip"))
     if vecnorm:
-        venv.save(str(out / "model_vecnormalize.pkl"))
+        save_vecnorm(venv, out / "model_vecnormalize.json")
     venv.close()
     return {"wall_s": wall, "steps": int(model.num_timesteps), "curve": curve,
-            "model": str(out / "model.zip"), "vecnorm": str(out / "model_vecnormalize.pkl")}
+            "model": str(out / "model.zip"), "vecnorm": str(out / "model_vecnormalize.json")}
 
 
 def train_finetune(seed: int, steps: int, out: Path, runs: Path, quick: bool = False) -> dict:
@@ -310,7 +311,7 @@ def train_finetune(seed: int, steps: int, out: Path, runs: Path, quick: bool = F
     from stable_baselines3 import PPO
     from stable_baselines3.common.monitor import Monitor
     from stable_baselines3.common.utils import set_random_seed
-    from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
+    from stable_baselines3.common.vec_env import DummyVecEnv
 
     import boom_env  # noqa: F401
     base = load_cache(runs / "rows" / "ppo_vector.json")["seeds"].get(str(seed))
@@ -326,10 +327,10 @@ def train_finetune(seed: int, steps: int, out: Path, runs: Path, quick: bool = F
 
     def make():
         return Monitor(gym.make(ENV_ID, fidelity=TRAIN_FIDELITY, **env_kwargs()))
-    venv = VecNormalize.load(base["vecnorm"], DummyVecEnv([make]))
+    venv = to_vecnormalize(load_vecnorm(base["vecnorm"]), DummyVecEnv([make]))
     venv.training = False
     venv.seed(seed)
-    model = PPO.load(base["model"], env=venv, device="cpu", seed=seed, **settings)
+    model = load_sb3(PPO, base["model"], env=venv, device="cpu", seed=seed, **settings)
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     model.learn(total_timesteps=steps, reset_num_timesteps=True)
@@ -339,10 +340,10 @@ def train_finetune(seed: int, steps: int, out: Path, runs: Path, quick: bool = F
         total += int(e["l"])
         curve.append((total, float(e["r"])))
     model.save(str(out / "model.zip"))
-    venv.save(str(out / "model_vecnormalize.pkl"))
+    save_vecnorm(venv, out / "model_vecnormalize.json")
     venv.close()
     return {"wall_s": wall, "steps": int(model.num_timesteps), "curve": curve,
-            "model": str(out / "model.zip"), "vecnorm": str(out / "model_vecnormalize.pkl")}
+            "model": str(out / "model.zip"), "vecnorm": str(out / "model_vecnormalize.json")}
 
 
 def train_zoo(algo: str, seed: int, steps: int, out: Path) -> dict:
@@ -370,9 +371,10 @@ def train_zoo(algo: str, seed: int, steps: int, out: Path) -> dict:
     for _, ret, n in sorted(eps):
         total += n
         curve.append((total, ret))
+    # RL Zoo pickles the statistics: converted here, right after this process's own training
+    vecnorm = convert_trusted_pickle(os.path.join(run, name, "vecnormalize.pkl"))
     return {"wall_s": wall, "steps": steps, "curve": _smooth(curve),
-            "model": os.path.join(run, f"{name}.zip"),
-            "vecnorm": os.path.join(run, name, "vecnormalize.pkl")}
+            "model": os.path.join(run, f"{name}.zip"), "vecnorm": str(vecnorm)}
 
 
 def train_residual(seed: int, steps: int, out: Path) -> dict:
@@ -399,7 +401,7 @@ def train_residual(seed: int, steps: int, out: Path) -> dict:
             except (ValueError, IndexError):
                 pass
     return {"wall_s": wall, "steps": steps, "curve": curve, "model": str(path),
-            "vecnorm": str(out / "model_vecnormalize.pkl")}
+            "vecnorm": str(out / "model_vecnormalize.json")}
 
 
 def _smooth(curve, window: int = 20):

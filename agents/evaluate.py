@@ -192,10 +192,10 @@ class PPOPolicy:
 
     def __init__(self, model_path: str | os.PathLike, vecnorm_path: str | os.PathLike | None = None,
                  a_max: float = 0.25):
-        import pickle
-
         from stable_baselines3 import PPO
-        self.model = PPO.load(str(model_path), device="cpu")
+
+        from .model_io import load_sb3, load_vecnorm
+        self.model = load_sb3(PPO, model_path, device="cpu")
         self.a_max = float(a_max)         # m/s^2, the env's (to undo the increment action)
         vecnorm_path = Path(vecnorm_path) if vecnorm_path else _vecnorm_for(Path(model_path))
         self.obs_rms, self.clip_obs, self.eps = None, 10.0, 1e-8
@@ -210,8 +210,7 @@ class PPOPolicy:
             self.residual = info.get("residual")
         self.tracker = None
         if vecnorm_path.exists():
-            with open(vecnorm_path, "rb") as f:
-                vn = pickle.load(f)
+            vn = load_vecnorm(vecnorm_path)
             self.obs_rms, self.clip_obs, self.eps = vn.obs_rms, vn.clip_obs, vn.epsilon
 
     def bind(self, env) -> None:
@@ -249,7 +248,8 @@ class PPOPolicy:
 
 
 def _vecnorm_for(model_path: Path) -> Path:
-    return model_path.with_name(model_path.stem + "_vecnormalize.pkl")
+    from .model_io import vecnorm_path_for
+    return vecnorm_path_for(model_path)
 
 
 
@@ -355,7 +355,7 @@ def atomic_write_text(path, text: str) -> None:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m agents.evaluate", description=__doc__.split("\n\n")[0])
-    ap.add_argument("--model", nargs="+", help="PPO model .zip (its *_vecnormalize.pkl beside "
+    ap.add_argument("--model", nargs="+", help="PPO model .zip (its *_vecnormalize.json beside "
                                                "it); several: one column each; omit to "
                                                "evaluate the scripted schedules only")
     ap.add_argument("--episodes", type=int, default=1, help="episodes per controller (seeds "

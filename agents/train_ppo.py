@@ -17,8 +17,8 @@ which is faster for the cheap modal env on a loaded machine: see benchmarks/resu
 a progress bar, optional TensorBoard logging (``--tensorboard DIR``, needs ``tensorboard``),
 periodic checkpoints, and on exit:
 
-* ``DIR/model.zip`` and ``DIR/model_vecnormalize.pkl`` (the observation statistics the policy
-  needs at evaluation, see ``agents.evaluate.PPOPolicy``);
+* ``DIR/model.zip`` and ``DIR/model_vecnormalize.json`` (the observation statistics the policy
+  needs at evaluation as JSON, see ``agents.evaluate.PPOPolicy`` and ``agents.model_io``);
 * ``DIR/learning_curve.csv``: environment steps, episodes, mean return of the last 20 finished
   training episodes (the stochastic policy's undiscounted, unnormalised env return) and their
   success rate.
@@ -300,8 +300,8 @@ def train(timesteps: int, seed: int, out: str | os.PathLike, n_envs: int | None 
         model.save(str(out / "model.tmp.zip"))
         os.replace(out / "model.tmp.zip", path)
         if vecnorm:
-            venv.save(str(out / "model_vecnormalize.tmp.pkl"))
-            os.replace(out / "model_vecnormalize.tmp.pkl", out / "model_vecnormalize.pkl")
+            from .model_io import save_vecnorm
+            save_vecnorm(venv, out / "model_vecnormalize.json")
         import json
 
         from .evaluate import atomic_write_text

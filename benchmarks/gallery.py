@@ -154,7 +154,9 @@ def page() -> str:
              "`docs/gallery/`.  The animations exaggerate the booms' deflection; run "
              "`boom-sim run SCENE --animate` or `boom-sim animate` for your own "
              "([user guide](user_guide.md#seeing-the-crane-move)); how long each scene takes "
-             "is on the [performance](performance.md) page.", ""]
+             "is on the [performance](performance.md) page (a report's wall time is its own "
+             "run's, with the figures and the animation, on a machine that was doing other "
+             "work: not a speed measurement).", ""]
     for name in sorted(shipped_scenes()):
         meta_path = GALLERY / name / "meta.json"
         lines += [f"## `{name}`", ""]

@@ -179,6 +179,10 @@ def main(argv: list[str] | None = None) -> int:
              + f" ({t_end:g} s simulated), {args.repeat} run(s) per case; "
              "median [min, max].  Written by benchmarks/loaded_speed.py (its docstring "
              "describes the cases and columns).", "",
+             "Which figure is which: this table compares machine states (two cores, one "
+             "core, beside other work) for one command at one commit; the time of every "
+             "shipped scene on one core is `scene_speed.md`, each table gives its own commit "
+             "and date, so compare rows within one table.", "",
              "Machine:", "", *_machine(),
              f"- load average (1, 5, 15 min) before: {load_before[0]:.2f}, {load_before[1]:.2f}, "
              f"{load_before[2]:.2f}; after: {load_after[0]:.2f}, {load_after[1]:.2f}, "

@@ -2,15 +2,17 @@
 
     python benchmarks/paper_comparison.py                 # all cases (~15 runs), the report
     python benchmarks/paper_comparison.py --quick --out /tmp/pc --report /tmp/pc/validation.md
+    python benchmarks/paper_comparison.py --verdict-only  # only the opening table, from the page
 
 Runs the three paper scenes (``telescopic_extraction`` = Section 9.2, ``telescopic_retraction``
 = its retraction, ``telescopic_extraction_rigid`` = Section 9.1) under every slider-moment model
 (contact.moment_model: rigid, seat, couple) and, for the frictional scenes, every friction normal
 load (contact.friction_load: resultant, springs), and writes
 
-* ``docs/validation.md``: one row per quantitative or qualitative statement of Section 9 (figure,
-  statement, our value, holds or not) for every model, the luffing-cylinder reading and the
-  reasons where a statement does not hold;
+* ``docs/validation.md``: opening with the verdict (every statement, one line each: holds,
+  explained or fails under the default models), then one row per quantitative or qualitative
+  statement of Section 9 (figure, statement, our value, holds or not) for every model, the
+  luffing-cylinder reading and the reasons where a statement does not hold;
 * figures ``docs/img/validation_*.png``: the models side by side;
 * ``benchmarks/results/paper_comparison/summary.csv``: wall time, steps and the headline values
   of every case (the result folders themselves are not committed).
@@ -25,6 +27,7 @@ from __future__ import annotations
 import argparse
 import csv
 import io
+import re
 import sys
 import time
 from dataclasses import dataclass
@@ -194,6 +197,113 @@ def mark(h) -> str:
     return "-" if h is None else ("holds" if h else "**does not hold**")
 
 
+# ----------------------------------------------------------------------------- the verdict
+
+#: the page's opening section (right below its title), made by :func:`with_verdict`
+VERDICT_HEADING = "## Verdict"
+_WHY_ANCHOR = "#statements-that-do-not-hold-under-the-defaults-and-why"
+_SCENES = ("telescopic_extraction_rigid", "telescopic_extraction", "telescopic_retraction")
+
+
+@dataclass(frozen=True)
+class Statement:
+    """One statement of Section 9 under the default contact models, as a detailed table holds
+    it: the scene, the figure, the statement, our value and whether it holds (None: reported,
+    the paper states nothing to check)."""
+    scene: str
+    figure: str
+    statement: str
+    value: str
+    holds: bool | None
+
+
+def reason(statement: str) -> str | None:
+    """Why a statement does not hold under the defaults (:data:`REASONS`), None if unknown."""
+    return next((text for key, text in REASONS.items() if key in statement), None)
+
+
+def verdict_of(st: Statement) -> str:
+    """holds, explained (does not hold, for the reason the page gives), fails or reported."""
+    if st.holds is None:
+        return "reported"
+    if st.holds:
+        return "holds"
+    return "explained" if reason(st.statement) else "**fails**"
+
+
+def statements_of(results: dict) -> list[Statement]:
+    """The statements of the default cases of ``results``, in the page's order."""
+    return [Statement(c.scene, row.figure, row.statement, row.value, row.holds)
+            for scene in _SCENES for c, r in results.items()
+            if c.scene == scene and c.is_default for row in ROWS[scene](r)]
+
+
+def _split_row(line: str) -> list[str]:
+    """A markdown table row's cells (an escaped "\\|" stays inside its cell, unescaped)."""
+    cells = re.split(r"(?<!\\)\|", line.strip())[1:-1]
+    return [c.strip().replace("\\|", "|") for c in cells]
+
+
+def statements_from_page(text: str) -> list[Statement]:
+    """The default column of every scene's detailed table of a page that :func:`report` wrote
+    (the committed results: the result files themselves are not committed)."""
+    out = []
+    for scene in _SCENES:
+        m = re.search(rf"^## .*\(`{scene}`\)$", text, flags=re.M)
+        if m is None:
+            continue
+        body = text[m.end():].split("\n## ", 1)[0]
+        lines = [ln for ln in body.splitlines() if ln.startswith("| Fig. |")]
+        if not lines:
+            continue
+        head = _split_row(lines[0])
+        col = next(i for i, h in enumerate(head) if h.endswith("(default)"))
+        start = body.index(lines[0])
+        for ln in body[start:].splitlines()[2:]:
+            if not ln.startswith("|"):
+                break
+            cells = _split_row(ln)
+            value, _, m_ = cells[col].rpartition(": ")
+            holds = None if m_ == "-" else m_ == "holds"
+            out.append(Statement(scene, cells[0], cells[1], value, holds))
+    return out
+
+
+def verdict(statements: list[Statement]) -> list[str]:
+    """The page's opening section: every statement of Section 9, one line each, with its
+    verdict under the default contact models."""
+    words = [verdict_of(st) for st in statements]
+    count = {w: words.count(w) for w in ("holds", "explained", "**fails**", "reported")}
+    lines = [VERDICT_HEADING, "",
+             f"Under the default contact models, **{count['holds']}** of the "
+             f"{len(statements) - count['reported']} statements of Section 9 hold, "
+             f"**{count['explained']}** do not and the page [explains why]({_WHY_ANCHOR}), "
+             f"**{count['**fails**']}** fail without an explanation"
+             + (f"; {count['reported']} of the quantities it states nothing about "
+                f"{'is' if count['reported'] == 1 else 'are'} reported" if count["reported"]
+                else "")
+             + ". The tables after this one give every contact model's values.", "",
+             "| scene | Fig. | statement | verdict | value (default models) |",
+             "|---|---|---|---|---|"]
+    for st, w in zip(statements, words):
+        lines.append(f"| `{st.scene}` | {st.figure} | {_cell(st.statement)} | {w} | "
+                     f"{_cell(st.value)} |")
+    return lines + [""]
+
+
+def with_verdict(text: str, statements: list[Statement] | None = None) -> str:
+    """The page with its verdict section (re)made from ``statements`` (default: those of the
+    page's own detailed tables), placed right below the page's title."""
+    if statements is None:
+        statements = statements_from_page(text)
+    if VERDICT_HEADING + "\n" in text:             # the previous verdict: replaced
+        a = text.index(VERDICT_HEADING + "\n")     # up to the blank line after its table
+        b = text.index("\n\n", text.index("\n|", a)) + 2
+        text = text[:a] + text[b:]
+    at = text.index("\n\n", text.index("# ")) + 2
+    return text[:at] + "\n".join(verdict(statements)) + "\n" + text[at:]
+
+
 def report(results: dict, img: Path, report_path: Path, quick: bool,
            machine: str = "machine state not recorded") -> str:
     lines = [
@@ -265,8 +375,7 @@ def report(results: dict, img: Path, report_path: Path, quick: bool,
     failing = [(c, row) for c, r in results.items() if c.is_default
                for row in ROWS[c.scene](r) if row.holds is False]
     for c, row in failing:
-        why = next((text for key, text in REASONS.items() if key in row.statement),
-                   "no explanation recorded")
+        why = reason(row.statement) or "no explanation recorded"
         lines += [f"* **{c.scene}, Fig. {row.figure}: {row.statement}** ({row.value}). {why}",
                   ""]
     if not failing:
@@ -296,7 +405,7 @@ def report(results: dict, img: Path, report_path: Path, quick: bool,
         "![slider forces](img/validation_sliders.png)",
         "",
     ]
-    return "\n".join(lines) + "\n"
+    return with_verdict("\n".join(lines) + "\n", statements_of(results))
 
 
 def main(argv=None) -> int:
@@ -309,8 +418,16 @@ def main(argv=None) -> int:
                     help="'default': only the default models")
     ap.add_argument("--machine", default="machine state not recorded",
                     help="the machine state the runs had, for the report's wall times")
+    ap.add_argument("--verdict-only", action="store_true",
+                    help="run nothing: remake the report's opening verdict table from its own "
+                         "detailed tables")
     args = ap.parse_args(argv)
     out, report_path = Path(args.out), Path(args.report)
+    if args.verdict_only:
+        text = report_path.read_text(encoding="utf-8")
+        atomic_write_bytes(report_path, with_verdict(text).encode())
+        print(f"verdict of {len(statements_from_page(text))} statements: {report_path}")
+        return 0
     img = report_path.parent / "img"
     results = {}
     rows = []

@@ -105,7 +105,12 @@ def main(argv: list[str] | None = None) -> int:
              f"{args.runs} run(s) per scene, the scenes taking turns, median [min, max].  "
              "Timed command: `OPENBLAS_NUM_THREADS=1 taskset -c 0 boom-sim run SCENE --out "
              f"<tmpdir> --quiet {' '.join(flags)}` (the numba kernels compiled and cached "
-             "beforehand).",
+             "beforehand).", "",
+             "Which figure is which: this table is the reference for the time of a whole "
+             "`boom-sim run` of each shipped scene.  `loaded_speed.md` times the paper "
+             "scene's command on other machine states (two cores, beside other work) and "
+             "`tolerance_accuracy.md` only `simulate` (no start-up, no files); each table "
+             "gives its own commit and date, so compare rows within one table.",
              "", "Machine state:", "", *machine_lines(cpu0, cpu1, load0, load1), "",
              "| scene | simulated s | method | DOF | wall s | RTF | cpu s | RTF on CPU | "
              "steps |",

@@ -76,6 +76,11 @@ def main(argv=None) -> None:
         f"outputs as a fraction of the reference force's range ({span / 1e3:.0f} kN).  Wall: "
         "`simulate` in this process.  Written by `benchmarks/tolerance_accuracy.py`.",
         "",
+        "Which figure is which: the wall times here are of `simulate` alone (model "
+        "build, integration, outputs), without the command's start-up and files, so "
+        "they compare methods and tolerances with each other; the whole command's time "
+        "is `scene_speed.md`, at its own commit and date.",
+        "",
         "Machine:",
         "",
         *machine_lines(cpu0, cpu1, load0, load1),

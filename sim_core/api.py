@@ -10,6 +10,8 @@ records the scene.
 
 from __future__ import annotations
 
+import os
+import time
 from pathlib import Path
 from typing import Any
 
@@ -24,7 +26,7 @@ def load_scene(name_or_path: str | Path, overrides: dict[str, Any] | None = None
     (``{"solver.t_end": 4}``) and validate it: the resolved scene, every default filled in.
     Bad input raises :class:`sim_core.SceneError` naming the field and the allowed range."""
     raw, source = read_scene(name_or_path)
-    if overrides:
+    if overrides is not None:
         raw = apply_overrides(raw, overrides)
     return system_kind(raw).validate(raw, source)
 
@@ -53,6 +55,51 @@ def simulate(scene: dict, progress=None, *, checkpoint: CheckpointPolicy | None 
     if checkpoint is None:
         if resume:
             raise ValueError("resume needs the checkpoint policy to resume from (checkpoint=)")
-        return system_kind(scene).run(scene, progress)
+        return _timed(lambda: system_kind(scene).run(scene, progress))
     ckpt = Checkpointer(checkpoint, scene_fingerprint(scene), resume)
-    return system_kind(scene).run(scene, progress, checkpoint=ckpt)
+    return _timed(lambda: system_kind(scene).run(scene, progress, checkpoint=ckpt))
+
+
+def _load() -> list[float] | None:
+    """The 1, 5 and 15 min load averages (runnable processes), None where the OS has none."""
+    try:
+        return [round(x, 2) for x in os.getloadavg()]
+    except (AttributeError, OSError):
+        return None
+
+
+def _usable_cpus() -> int | None:
+    """The logical CPUs this process may run on (its affinity), else the machine's count."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        return os.cpu_count()
+
+
+def _timed(run) -> Result:
+    """``run()`` with the machine state it ran in added to its Result's ``stats``.
+
+    ``wall_s``: wall time of the whole call (model build, statics, integration, outputs, s);
+    ``cpu_s``: this process's CPU time over it (``time.process_time``, every thread of the
+    process: the element worker's spinning counts, so it can exceed ``wall_s``); ``load_start``
+    / ``load_end``: the 1, 5, 15 min load averages at its start and end; ``usable_cpus``: the
+    logical CPUs the process may run on.  A load above ``usable_cpus`` means the run shared
+    its cores, and its wall time is longer than on an idle machine.  A failed solve's partial
+    result (``SimulationError.result``) gets them too.
+    """
+    load_start, cpus = _load(), _usable_cpus()
+    wall0, cpu0 = time.perf_counter(), time.process_time()
+
+    def stamp(result) -> None:
+        if isinstance(result, Result):
+            result.stats.update({"wall_s": time.perf_counter() - wall0,
+                                 "cpu_s": time.process_time() - cpu0,
+                                 "load_start": load_start, "load_end": _load(),
+                                 "usable_cpus": cpus})
+    try:
+        result = run()
+    except Exception as exc:
+        stamp(getattr(exc, "result", None))
+        raise
+    stamp(result)
+    return result

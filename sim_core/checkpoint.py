@@ -43,7 +43,13 @@ factors), 0.02-0.2 s to write (synced to disk), well under 1 % of a 30 s interva
 
 The file: a header line with the format, the SHA-256 of the body, then the body (a pickle
 of numbers, strings, tuples, lists, dicts and numpy arrays only, read back by a restricted
-unpickler that refuses anything else).  It is written through
+unpickler that refuses anything else: it resolves only the builtin containers and numbers
+listed in ``_ALLOWED`` and numpy's array and dtype reconstructors, so no other class or
+function is ever called).  The body's structure is then checked against what its integration
+path writes (``_STATES``: the keys, types, array dtypes and shapes, one state length across
+the arrays) and a restored solver attribute keeps the shape and kind of the fresh solver's,
+so a body with a valid checksum but another structure is refused like a damaged file.  It is
+written through
 :func:`sim_core.result.atomic_path` (a temporary file, synced, renamed over the old one), so
 a writer killed mid-write leaves the previous
 checkpoint whole (and a stale temporary file beside it, removed by the next run with the same
@@ -206,7 +212,129 @@ def decode(data: bytes, path) -> dict:
                                              "versions"} <= set(payload):
         raise CheckpointError(path, "corrupt body (fields missing); remove it and run without "
                                     "--resume")
+    try:
+        _check(payload, _BODY, "", {})
+        _check(payload["state"], _STATES[payload["driver"]], "state", {})
+    except _Malformed as exc:
+        raise CheckpointError(path, f"corrupt body ({exc}); remove it and run without "
+                                    "--resume") from None
     return payload
+
+
+# -- the body's structure ------------------------------------------------------------------------
+# What each integration path's :meth:`Checkpointer.save` writes and its resume reads
+# (sim_core.integrate.driver, generalized_alpha, rosenbrock): the reader checks it before
+# anything is restored.  A spec is a kind ("number", "integer", "string", "boolean", "object":
+# a dict with string keys whose values are checked where they are restored, "numbers": a list
+# or 1-D array of numbers, "any"), a dict of required keys (more keys are allowed), or a tuple:
+# ("array", shape, dtype kinds) with each dimension an int, None (any) or a symbol that takes
+# one length across the body, ("opt", spec) for None or spec, ("seq", spec) for a list, tuple
+# or array of spec, ("tuple", n, spec) for n of them, ("choice", values).
+
+class _Malformed(Exception):
+    """A body that does not have the structure its integration path writes."""
+
+
+def _vec(dim="n"):
+    return ("array", (dim,), "f")
+
+
+def _mat(rows="n", cols="n"):
+    return ("array", (rows, cols), "f")
+
+
+_STALL = {"times": _vec("window"), "walls": _vec("window"), "k": "integer", "slowest": "number"}
+_GA = {"ga": {**{k: _vec() for k in ("q", "v", "a", "qdd", "qdd_prev", "atol_q", "atol_v")},
+              "t": "number", "h_prev": "number", "step_index": "integer", "rtol": "number"},
+       "ev": {"n_calls": "integer", "n_tangent": "integer"}, "stats": "object",
+       "out": {"ts": "numbers", "ys": ("seq", ("tuple", 3, _vec())), "k": "integer"},
+       "loop": "object"}
+_ALPHA_COMMON = {"wall_s": "number", "warm": "object", "ga": _GA}
+_STATES = {
+    "scipy": {"solver_class": ("choice", ("RK45", "BDF")),
+              "solver": {"t": "number", "y": _vec()}, "ys": ("seq", _vec()),
+              "k_out": "integer", "steps": "numbers", "njev": "integer", "wall_s": "number",
+              "jac": ("opt", "object"), "switch": ("opt", "object"), "stall": _STALL,
+              "rhs": "object", "warm": "object"},
+    "alpha_numpy_fixed": _ALPHA_COMMON,
+    "alpha_numpy_adaptive": {**_ALPHA_COMMON, "shim": ("tuple", 2, "number"),
+                             "shim_y": _vec("2n"), "stall": _STALL},
+    # the compiled loops' arrays: carry and counts of driver._alpha_fixed / _alpha_adaptive
+    "alpha_fixed": {**{k: _vec() for k in ("q", "v", "a", "qdd", "qdd_prev")},
+                    "Sinv": _mat(), "carry": _vec(2), "counts": ("array", (6,), "iu"),
+                    "h_used": "numbers", "k": "integer",
+                    "out": ("tuple", 3, _mat(None, "n")), "ys": _mat(None, "2n"),
+                    "wall_s": "number"},
+    "alpha_adaptive": {**{k: _vec() for k in ("q", "v", "a", "qdd")},
+                       **{k: _mat() for k in ("Cr", "Kr", "Mr", "Sinv")},
+                       "Y": _mat(None, "2n"), "carry": _vec(3), "counts": ("array", (8,), "iu"),
+                       "hs": _vec(7), "k_out": "integer",
+                       "pace_marks": ("seq", ("tuple", 2, "number")),
+                       "pace_slowest": "number", "wall_s": "number"},
+    "ros2": {"k": "integer", "ys": ("seq", _vec("any")), "wall_s": "number", "warm": "object",
+             "ros2": {"age": "number", "stats": "object", "band": "any", "Jzz": "any",
+                      "Jzv": "any", "ft": "any"}},
+}
+_BODY = {"fingerprint": "string", "driver": ("choice", tuple(_STATES)), "t": "number",
+         "versions": "object", "state": "object"}
+_NUMBER = (int, float, np.integer, np.floating)
+
+
+def _check(v, spec, where: str, dims: dict) -> None:
+    """Raise _Malformed naming ``where`` (the dotted key) where ``v`` does not match ``spec``;
+    ``dims`` holds the lengths the symbols took."""
+    def bad(expected: str):
+        got = (f"shape {v.shape} of {v.dtype}" if isinstance(v, np.ndarray)
+               else type(v).__name__)
+        raise _Malformed(f"{where or 'the body'}: {expected} expected, got {got}")
+
+    if isinstance(spec, dict):
+        if not isinstance(v, dict):
+            bad("an object")
+        for key, sub in spec.items():
+            if key not in v:
+                raise _Malformed(f"{where + '.' if where else ''}{key} is missing")
+            _check(v[key], sub, f"{where}.{key}" if where else key, dims)
+        return
+    if isinstance(spec, str):
+        ok = {"number": lambda: isinstance(v, _NUMBER) and not isinstance(v, bool),
+              "integer": lambda: isinstance(v, (int, np.integer)) and not isinstance(v, bool),
+              "string": lambda: isinstance(v, str),
+              "boolean": lambda: isinstance(v, (bool, np.bool_)),
+              "object": lambda: isinstance(v, dict) and all(isinstance(k, str) for k in v),
+              "numbers": lambda: (isinstance(v, np.ndarray) and v.ndim == 1
+                                  and v.dtype.kind in "fiu")
+              or (isinstance(v, (list, tuple)) and all(isinstance(x, _NUMBER)
+                                                       and not isinstance(x, bool) for x in v)),
+              "any": lambda: True}[spec]()
+        if not ok:
+            bad({"integer": "an integer", "object": "an object", "any": ""}.get(spec, f"a {spec}"))
+        if spec == "number" and where == "t" and not math.isfinite(v):
+            raise _Malformed("t: a finite time expected")
+        return
+    kind = spec[0]
+    if kind == "opt":
+        if v is not None:
+            _check(v, spec[1], where, dims)
+    elif kind == "choice":
+        if not isinstance(v, str) or v not in spec[1]:
+            raise _Malformed(f"{where}: one of {', '.join(spec[1])} expected")
+    elif kind in ("seq", "tuple"):
+        items = list(v) if isinstance(v, (list, tuple, np.ndarray)) else None
+        n = spec[1] if kind == "tuple" else None
+        if items is None or (n is not None and len(items) != n):
+            bad(f"a sequence of {n}" if n is not None else "a sequence")
+        for i, x in enumerate(items):
+            _check(x, spec[-1], f"{where}[{i}]", dims)
+    else:                                   # ("array", shape, kinds)
+        shape, kinds = spec[1], spec[2]
+        if not isinstance(v, np.ndarray) or v.dtype.kind not in kinds or v.ndim != len(shape):
+            bad(f"a {len(shape)}-D array of {'floats' if kinds == 'f' else 'integers'}")
+        for size, dim in zip(v.shape, shape):
+            if isinstance(dim, str) and dim != "any":
+                dim = dims.setdefault(dim, size)
+            if dim not in (None, "any") and size != dim:
+                bad(f"a length of {dim}")
 
 
 def _fault(kind: str) -> bool:
@@ -303,6 +431,7 @@ class Checkpointer:
             raise CheckpointError(self.path, f"written by the {payload['driver']!r} integration "
                                              f"path, this run takes {driver!r}")
         self.resumed_from_s = float(payload["t"])
+        _TAKEN.set(str(self.path))
         return payload["state"]
 
     def unsupported(self, what: str) -> None:
@@ -351,6 +480,9 @@ class Checkpointer:
 
 _AMBIENT: contextvars.ContextVar = contextvars.ContextVar("sim_core_checkpointing",
                                                           default=None)
+# the checkpoint file the running resume took its state from (restore_object_state's errors)
+_TAKEN: contextvars.ContextVar = contextvars.ContextVar("sim_core_checkpoint_taken",
+                                                        default="(resumed checkpoint)")
 
 
 @contextlib.contextmanager
@@ -380,7 +512,25 @@ def object_state(obj, skip: tuple = ()) -> dict:
 
 def restore_object_state(obj, state: dict) -> None:
     """Set the attributes of :func:`object_state` on ``obj`` (a fresh object of the same class
-    whose callables are its own)."""
+    whose callables are its own).  An array attribute of ``obj`` takes only an array of its
+    shape and dtype kind, a number only a number or None: a checkpoint body that differs
+    raises :class:`CheckpointError` (the file :meth:`Checkpointer.take` read) before any
+    attribute is set."""
+    for k, v in state.items():
+        cur = getattr(obj, k, None)
+        what = None
+        if isinstance(cur, np.ndarray) and not (isinstance(v, np.ndarray) and v.shape == cur.shape
+                                                and v.dtype.kind == cur.dtype.kind):
+            what = f"an array of shape {cur.shape} of {cur.dtype.kind}-kind"
+        elif isinstance(cur, _NUMBER) and not isinstance(cur, (bool, np.bool_)) and not (
+                v is None or (isinstance(v, _NUMBER) and not isinstance(v, (bool, np.bool_)))):
+            what = "a number"
+        if what:
+            got = (f"shape {v.shape} of {v.dtype}" if isinstance(v, np.ndarray)
+                   else type(v).__name__)
+            raise CheckpointError(_TAKEN.get(), f"corrupt body ({type(obj).__name__}.{k}: {what} "
+                                                f"expected, got {got}); remove it and run "
+                                                "without --resume")
     for k, v in state.items():
         setattr(obj, k, v)
 

@@ -1,28 +1,45 @@
-"""Command line: ``boom-sim run|sweep|list|describe|plot|animate|export|report``.
+"""Command line: ``boom-sim run|sweep|list|describe|plot|animate|export|report|dynamic-factor|fmu``.
+
+``dynamic-factor`` runs a lift-off scene over a grid and writes the hoisting factor φ2
+(:mod:`sim_core.dynamic_factor`); ``fmu`` packs a scene as an FMI 2.0 co-simulation FMU
+(:mod:`sim_core.fmu`).
 
 ``run`` writes result.npz, summary.json, the figures and report.html (:mod:`sim_core.report`:
 one self-contained page with the summary, the self-checks and an interactive plot of every
 output; ``--no-report`` skips it); ``report`` writes that page again from a result file.
 While it runs, ``run`` keeps the integrator's whole state in OUT/checkpoint.pkl
 (``--checkpoint-every``, every 30 wall seconds by default; :mod:`sim_core.checkpoint`) and
-``run --resume`` continues a killed run from it; a bad checkpoint exits with status 2.
+``run --resume`` continues a killed run from it (and starts from t = 0 where there is none);
+a damaged checkpoint or one of another scene exits with status 2.
 Errors in the scene (or an unreadable result file for ``plot``, ``report``, ...) exit with
 status 2 and a one-line message; a failed solve exits with status 3 and a one-line message
 (time and reason), after writing summary.json with the error and, if the solver attached one
 to the SimulationError (``.result``), the partial result.npz.  ``sweep`` (:mod:`sim_core.sweep`)
 exits with status 2 for an invalid case or grid before running anything, 3 if any case failed (the
 others still run) and 130 when interrupted (finished cases and the summary are kept).
+
+``run``'s wall budget ``solver.max_wall_s`` covers the whole run (statics, integration,
+outputs, figures, report: :mod:`sim_core.run_control`); Ctrl-C only sets the run's interrupt
+flag, which every phase checks with the budget, so a run out of budget or interrupted exits
+with status 3 and its partial result (a second Ctrl-C quits at once, status 130).  ``run``
+and ``sweep`` lock their output folder while they write into it: a second writer is refused
+with status 2, as is an ``--out`` naming a file (or, for ``report`` and ``animate``, a folder),
+before anything runs.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
+import os
 import re
+import signal
 import sys
 import time
 from pathlib import Path
 
+from sim_core import run_control
 from sim_core.api import load_scene, simulate
 from sim_core.errors import SceneError, SimulationError
 from sim_core.registry import system_kind
@@ -102,50 +119,160 @@ def _checkpoint_policy(args, out: Path):
 
 
 CHECKPOINT_FILE = "checkpoint.pkl"
+#: the animation ``run --animate`` writes into its output folder (``report`` embeds it)
+ANIMATION_FILE = "anim.gif"
+
+
+def _out_folder(path: str, option: str = "--out", create: bool = True) -> Path:
+    """An output folder named on the command line, checked before anything runs: not a file
+    (nor below one), and created where ``create`` (a folder that cannot be created or written
+    is an input error naming ``option``)."""
+    out = Path(path)
+    if out.exists() and not out.is_dir():
+        raise _InputError(f"{option} {path!r}: is a file, not a folder")
+    for parent in out.parents:
+        if parent.exists() and not parent.is_dir():
+            raise _InputError(f"{option} {path!r}: {str(parent)!r} is a file, not a folder")
+    if create:
+        try:
+            out.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise _InputError(f"{option} {path!r}: cannot create the folder: "
+                              f"{exc.strerror or exc}") from None
+        if not os.access(out, os.W_OK | os.X_OK):
+            raise _InputError(f"{option} {path!r}: the folder is not writable")
+    return out
+
+
+def _out_file(path: str, option: str = "--out") -> Path:
+    """An output file named on the command line, checked before anything is computed: not a
+    folder, and its folder not a file."""
+    out = Path(path)
+    if out.is_dir():
+        raise _InputError(f"{option} {path!r}: is a folder, not a file")
+    for parent in out.parents:
+        if parent.exists() and not parent.is_dir():
+            raise _InputError(f"{option} {path!r}: {str(parent)!r} is a file, not a folder")
+    return out
+
+
+@contextlib.contextmanager
+def _folder_locked(out: Path, option: str = "--out"):
+    """The output folder's lock (sim_core.run_control.folder_lock) for the block; a folder in
+    use by another boom-sim is an input error (exit status 2)."""
+    with contextlib.ExitStack() as stack:
+        try:
+            stack.enter_context(run_control.folder_lock(out, option))
+        except run_control.FolderBusy as exc:
+            raise _InputError(str(exc)) from None
+        yield
+
+
+@contextlib.contextmanager
+def _interrupt_flag(budget: run_control.RunBudget):
+    """Within the block Ctrl-C (SIGINT) only sets the run's interrupt flag, which every phase
+    checks with its wall budget (sim_core.run_control), so that no KeyboardInterrupt is raised
+    inside compiled code; a second Ctrl-C raises KeyboardInterrupt at once (force-quit)."""
+    def handler(signum, frame):
+        if budget.interrupted:
+            raise KeyboardInterrupt
+        budget.interrupt()
+    try:
+        old = signal.signal(signal.SIGINT, handler)
+    except ValueError:            # not the main thread: signals stay as they are
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, old)
 
 
 def cmd_run(args) -> int:
+    # the run's wall budget (solver.max_wall_s) counts from here: statics, integration,
+    # outputs, files, figures and report
+    budget = run_control.RunBudget(None)
+    with _interrupt_flag(budget):
+        _out_folder(args.out, create=False)             # a file named --out: before the run
+        scene = load_scene(args.scene, _overrides(args.set))
+        budget.max_wall_s = scene["solver"].get("max_wall_s")
+        out = _out_folder(args.out)
+        policy = _checkpoint_policy(args, out)
+        try:
+            with _folder_locked(out), run_control.run_budget(budget):
+                return _run(args, scene, out, policy)
+        except KeyboardInterrupt:         # a second Ctrl-C: quit without the partial result
+            print(f"boom-sim: interrupted twice: stopped without writing the partial result "
+                  f"(files in {out} may be incomplete)", file=sys.stderr)
+            return 130
+
+
+def _run(args, scene: dict, out: Path, policy) -> int:
+    """``run`` in its locked output folder under the run's budget (cmd_run)."""
     from sim_core.checkpoint import CheckpointError, checkpointing
-    scene = load_scene(args.scene, _overrides(args.set))
-    out = Path(args.out)
-    policy = _checkpoint_policy(args, out)
+    resume = bool(args.resume)
+    if resume and policy is not None and not Path(policy.path).exists():
+        # nothing to continue (no run was cut short here, or it finished): a fresh run, so
+        # that one command line serves the first start and every restart of a batch job
+        print(f"boom-sim: no checkpoint in {policy.path}: starting from t = 0", file=sys.stderr)
+        resume = False
     prog = _Progress(scene["solver"]["t_end"], not args.quiet)
     try:
-        with checkpointing(policy, resume=bool(args.resume)):
+        with checkpointing(policy, resume=resume):
             result = simulate(scene, progress=prog)
     except CheckpointError as exc:
         prog.close(finished=False)
         raise _InputError(str(exc)) from None
     except SimulationError as exc:
         prog.close(finished=False)
-        note = _save_failure(scene, out, exc)
-        if policy is not None and Path(policy.path).is_file():
-            note += f"; the last checkpoint is kept ({policy.path}: --resume continues from it)"
-        print(f"boom-sim: {_one_line(exc)}{note}", file=sys.stderr)
-        return 3
+        return _failed(scene, out, exc, policy)
     prog.close()
-    result.save(out / "result.npz")
-    summary = {"scene": scene["name"], **result.stats}
-    atomic_write_bytes(out / "summary.json", json.dumps(summary, indent=2, default=str).encode())
-    if policy is not None:          # the result is written: the checkpoint is obsolete
-        policy.clear()
-    figs = [] if args.no_plots else _plots(result, out)
-    if args.animate:
-        figs.append(_animate(result, out / "anim.gif"))
-    report = None if args.no_report else _report(result, out / "report.html",
-                                                 out / "anim.gif" if args.animate else None)
+    try:
+        result.save(out / "result.npz")
+        summary = {"scene": scene["name"], **result.stats}
+        atomic_write_bytes(out / "summary.json",
+                           json.dumps(summary, indent=2, default=str).encode())
+        if policy is not None:          # the result is written: the checkpoint is obsolete
+            policy.clear()
+        t_last = float(result.t[-1]) if len(result.t) else 0.0
+        run_control.check("figures", t_last)
+        figs = [] if args.no_plots else _plots(result, out)
+        if args.animate:
+            run_control.check("figures", t_last)
+            figs.append(_animate(result, out / ANIMATION_FILE))
+        report = None
+        if not args.no_report:
+            run_control.check("report", t_last)
+            report = _report(result, out / "report.html",
+                             out / ANIMATION_FILE if args.animate else None)
+    except SimulationError as exc:     # the budget or Ctrl-C after the result: it is whole
+        exc.result = result
+        return _failed(scene, out, exc, policy)
     st = result.stats
     wall = float(st.get("wall_time_s", 0.0))
     rtf = st.get("real_time_factor", scene["solver"]["t_end"] / max(wall, 1e-12))
     work = "; ".join(f"{st[k]} {label}" for k, label in
                      (("n_steps", "steps"), ("n_rhs", "RHS")) if k in st)
+    load = st.get("load_start")
+    machine = (f"; whole run {st['wall_s']:.1f} s wall, {st['cpu_s']:.1f} s CPU"
+               + (f", load {load[0]:g} on {st.get('usable_cpus', '?')} CPUs" if load else "")
+               if "wall_s" in st and "cpu_s" in st else "")
     print(f"{scene['name']}: {scene['solver']['t_end']:g} s simulated in {wall:.1f} s wall "
-          f"(RTF {rtf:.3g})" + (f"; {work}" if work else "") + f"; wrote {out}/result.npz, "
+          f"(RTF {rtf:.3g})" + (f"; {work}" if work else "") + machine + f"; wrote {out}/result.npz, "
           f"summary.json" + (f", {len(figs)} figures" if figs else "")
           + (", report.html" if report else ""))
     if result.suspect:                 # a cheap self-check failed (summary.json: failed_checks)
         print(f"boom-sim: warning: {result.suspect_note()}", file=sys.stderr)
     return 0
+
+
+def _failed(scene: dict, out: Path, exc: SimulationError, policy) -> int:
+    """A failed run's files (:func:`_save_failure`), its one-line message; exit status 3."""
+    note = _save_failure(scene, out, exc)
+    if policy is not None and Path(policy.path).is_file():
+        note += f"; the last checkpoint is kept ({policy.path}: --resume continues from it)"
+    print(f"boom-sim: {_one_line(exc)}{note}", file=sys.stderr)
+    return 3
 
 
 def _save_failure(scene: dict, out: Path, exc: SimulationError) -> str:
@@ -172,7 +299,9 @@ def _save_failure(scene: dict, out: Path, exc: SimulationError) -> str:
         return ""
     if partial is None:
         return f"; no partial result (summary.json written to {out})"
-    t_last = float(partial.t[-1]) if len(partial.t) else 0.0
+    if not len(partial.t):
+        return f"; no output times reached (result.npz written to {out})"
+    t_last = float(partial.t[-1])
     return f"; partial result up to t = {t_last:.6g} s written to {out / 'result.npz'}"
 
 
@@ -194,6 +323,7 @@ def _animate(result: Result, out: Path, **kw) -> Path:
 
 
 def cmd_animate(args) -> int:
+    _out_file(args.out)
     res = _load_result(args.result)
     kw = {"scale": args.scale, "speed": args.speed, "fps": args.fps, "t_start": args.t_start,
           "t_end": args.t_end, "view": args.view}
@@ -206,6 +336,7 @@ def cmd_animate(args) -> int:
 
 def cmd_export(args) -> int:
     from sim_core.vtk_export import export_vtk
+    _out_folder(args.vtk, "--vtk", create=False)
     res = _load_result(args.result)
     try:
         pvd = export_vtk(res, Path(args.vtk))
@@ -215,7 +346,8 @@ def cmd_export(args) -> int:
     return 0
 
 
-def _report(result: Result, path: Path, animation: Path | None = None) -> Path | None:
+def _report(result: Result, path: Path, animation: Path | None = None,
+            plotlyjs: bool | str = True) -> Path | None:
     """The run's report (sim_core.report); a missing plotly only skips it (the result files
     are already written), a bad animation file or a failed write is an input error."""
     try:
@@ -226,20 +358,24 @@ def _report(result: Result, path: Path, animation: Path | None = None) -> Path |
         print("boom-sim: warning: plotly is not installed, report.html skipped", file=sys.stderr)
         return None
     try:
-        return write_report(result, path, animation=animation)
+        return write_report(result, path, animation=animation, include_plotlyjs=plotlyjs)
     except (ValueError, OSError) as exc:
         raise _InputError(f"cannot write the report: {_one_line(exc)}") from None
 
 
 def cmd_report(args) -> int:
+    out = _out_file(args.out) if args.out else Path(args.result).parent / "report.html"
     res = _load_result(args.result)
-    out = Path(args.out) if args.out else Path(args.result).parent / "report.html"
     try:
         import plotly  # noqa: F401
     except ImportError:
         raise _InputError("plotly is not installed (pip install plotly)") from None
-    path = _report(res, out, Path(args.animation) if args.animation else None)
-    print(f"wrote {path}")
+    # the run's animation (run --animate) where one sits beside the result
+    beside = Path(args.result).parent / ANIMATION_FILE
+    animation = (Path(args.animation) if args.animation else
+                 beside if not args.no_animation and beside.is_file() else None)
+    path = _report(res, out, animation, "directory" if args.plotly_beside else True)
+    print(f"wrote {path}" + (f" (animation: {animation})" if animation is not None else ""))
     return 0
 
 
@@ -285,8 +421,10 @@ def cmd_describe(args) -> int:
 
 
 def cmd_plot(args) -> int:
+    if args.out:
+        _out_folder(args.out, create=False)
     res = _load_result(args.result)
-    out = Path(args.out) if args.out else Path(args.result).parent
+    out = _out_folder(args.out) if args.out else Path(args.result).parent
     try:
         import matplotlib  # noqa: F401
     except ImportError:
@@ -296,22 +434,39 @@ def cmd_plot(args) -> int:
     return 0
 
 
-def cmd_sweep(args) -> int:
-    from sim_core.sweep import SweepError, parse_grid, run_sweep
+def _grid_and_fixed(args) -> tuple[dict, dict]:
+    """The --grid values and the --set overrides of a sweep; a key in both is refused."""
+    from sim_core.sweep import parse_grid
     grid = parse_grid(args.grid)
     fixed = _overrides(args.set)
     both = sorted(set(grid) & set(fixed))
     if both:
         raise SceneError(f"--grid {both[0]} and --set {both[0]}: a key is either swept or fixed")
+    return grid, fixed
+
+
+def cmd_sweep(args) -> int:
+    from sim_core.sweep import SweepError, run_sweep
+    grid, fixed = _grid_and_fixed(args)
     t0 = time.perf_counter()
     try:
         every = args.checkpoint_every
         if not every >= 0:
             raise _InputError(f"--checkpoint-every {every:g}: wall seconds between a case's "
                               "checkpoints, allowed [0, inf) (0: none)")
-        rows = run_sweep(args.scene, grid, args.out, fixed=fixed, address=args.address,
-                         workers=args.workers, quiet=args.quiet, plots=args.plots,
-                         retries=args.retries, checkpoint_every=every or float("inf"))
+        fresh = not Path(args.out).exists()
+        out = _out_folder(args.out)
+        try:
+            with _folder_locked(out):         # one sweep at a time writes into --out
+                rows = run_sweep(args.scene, grid, args.out, fixed=fixed,
+                                 address=args.address, workers=args.workers, quiet=args.quiet,
+                                 plots=args.plots, retries=args.retries,
+                                 checkpoint_every=every or float("inf"))
+        except (SweepError, SceneError):
+            if fresh:                         # refused before any case ran: leave no folder
+                with contextlib.suppress(OSError):
+                    out.rmdir()
+            raise
     except SweepError as exc:
         raise _InputError(str(exc)) from None
     except KeyboardInterrupt:
@@ -332,6 +487,47 @@ def cmd_sweep(args) -> int:
 
 class _InputError(Exception):
     """A bad command-line input other than a scene (exit status 2)."""
+
+
+def cmd_dynamic_factor(args) -> int:
+    """The hoisting load case over a grid (:mod:`sim_core.dynamic_factor`): exit 2 for a bad
+    scene or grid, 3 if a cell failed (the others still run)."""
+    from sim_core.dynamic_factor import dynamic_factor
+    from sim_core.sweep import SweepError
+    grid, fixed = _grid_and_fixed(args)
+    t0 = time.perf_counter()
+    try:
+        out = _out_folder(args.out)
+        with _folder_locked(out):
+            rows = dynamic_factor(args.scene, grid, out, fixed=fixed, slack=args.slack,
+                                  after=args.after,
+                                  serial=True if args.serial else None, workers=args.workers,
+                                  quiet=args.quiet)
+    except SweepError as exc:
+        raise _InputError(str(exc)) from None
+    failed = [r for r in rows if r["status"] == "failed"]
+    print(f"{args.scene}: {len(rows)} lift-offs in {time.perf_counter() - t0:.1f} s wall, "
+          f"{len(failed)} failed; wrote {out}/dynamic_factor.{{csv,md,png}}")
+    for r in failed:
+        print(f"boom-sim: case {r['case']} failed: {r.get('error')}", file=sys.stderr)
+    return 3 if failed else 0
+
+
+_DYNAMIC_FACTOR_HELP = """\
+The hoisting load case (EN 13001-2 / ISO 8686-1): lift a grounded payload off for every cell
+of the --grid (boom lengths or strokes, luffing angles, hoisting speeds hoist_drive.v_max) and
+write into --out the case folders, dynamic_factor.csv and .md (per cell: working radius,
+hoisting speed v_h, phi2 = peak rope force / static rope force, the rigid-crane value
+1 + (v_h/g) sqrt(k/m), the tip's peak deflection, EN 13001-2's phi2 = phi2_min + beta2 v_h for
+HC1-HC4) and dynamic_factor.png (phi2 and the deflection against the working radius).  The
+scene needs effects.ground and a [hoist_drive] winding in; each cell starts with the rope
+--slack m slack and runs --after s past the time the hoist has wound that in.  Cells run as
+Ray tasks where Ray is installed (--serial: one after the other here).
+
+example:
+  boom-sim dynamic-factor crane_lift_off --grid booms.luffing_angle_deg=30,45,60 \\
+      --grid hoist_drive.v_max=0.25,0.5 --out phi2
+"""
 
 
 _SWEEP_HELP = """\
@@ -362,6 +558,93 @@ sweeps:
 """
 
 
+def cmd_fmu(args) -> int:
+    """Pack a scene as an FMI 2.0 co-simulation FMU (:mod:`sim_core.fmu`): exit 2 for a bad
+    scene or option."""
+    from sim_core.fmu import build_fmu
+    out = _out_file(args.out)
+    if out.suffix != ".fmu":
+        raise _InputError(f"--out {args.out!r}: an FMU file name ends in .fmu")
+    lists = {k: None if v is None else [x.strip() for x in ",".join(v).split(",") if x.strip()]
+             for k, v in (("outputs", args.outputs), ("inputs", args.inputs))}
+    path, cfg = build_fmu(args.scene, out, step_size=args.step, overrides=_overrides(args.set),
+                          parameters=args.param or (), outputs=lists["outputs"],
+                          inputs=lists["inputs"], limits=args.limits, stop_time=args.stop_time,
+                          model_name=args.name)
+    print(f"wrote {path}: {cfg['model_name']}, {len(cfg['inputs'])} inputs, "
+          f"{len(cfg['outputs'])} outputs, {len(cfg['parameters'])} parameters, "
+          f"step {cfg['step_size']:g} s")
+    return 0
+
+
+_FMU_HELP = """\
+Pack a scene as an FMI 2.0 co-simulation FMU (pythonfmu): inputs command_<actuator> (the
+actuator's acceleration, m/s^2 or rad/s^2, held over each communication step), outputs one
+scalar per component of the chosen outputs (tip_position_x, ..., actuator_<name>_position),
+parameters the scene keys named with --param (applied when the FMU is initialized).  The FMU
+carries the scene; running it needs Python with telescopic-boom-sim (this version) installed
+on the target machine.  Needs pip install 'telescopic-boom-sim[fmu]'.
+
+example:
+  boom-sim fmu crane_lift_and_slew --out crane.fmu --step 0.01 --param payload.mass \\
+      --outputs tip_position,sway_angle,hoist_rope_force,actuators
+"""
+
+
+def _fmu_parser(sub) -> None:
+    fm = sub.add_parser("fmu", help="pack a scene as an FMI 2.0 co-simulation FMU",
+                        description=_FMU_HELP,
+                        formatter_class=argparse.RawDescriptionHelpFormatter)
+    fm.add_argument("scene", help="shipped scene name or path to a TOML scene")
+    fm.add_argument("--out", required=True, help="the FMU file (NAME.fmu)")
+    fm.add_argument("--step", type=float, default=0.01, metavar="S",
+                    help="the default communication step, s (default: %(default)g; the "
+                         "importer may use others)")
+    fm.add_argument("--set", action="append", metavar="KEY=VALUE",
+                    help="fix a scene value in the FMU")
+    fm.add_argument("--param", action="append", metavar="KEY",
+                    help="a scene key (a number) as an FMU parameter, e.g. payload.mass "
+                         "(repeat for more)")
+    fm.add_argument("--outputs", action="append", metavar="NAME,...",
+                    help="the outputs (Simulation.outputs names; default: tip position and "
+                         "deflection, sway angles, cylinder forces, slew torque, rope force, "
+                         "pad forces and the actuators, those the scene has)")
+    fm.add_argument("--inputs", action="append", metavar="ACTUATOR,...",
+                    help="the commanded actuators (default: all); the others follow the "
+                         "scene's profiles")
+    fm.add_argument("--limits", choices=("raise", "clip"), default="raise",
+                    help="a command beyond an actuator's limits fails the step (raise, "
+                         "default) or is held at the limits (clip)")
+    fm.add_argument("--stop-time", type=float, default=None, metavar="S",
+                    help="the default experiment's stop time, s (default: solver.t_end)")
+    fm.add_argument("--name", default=None,
+                    help="the model identifier (default: the scene's name)")
+    fm.set_defaults(func=cmd_fmu)
+
+
+def _dynamic_factor_parser(sub) -> None:
+    df = sub.add_parser("dynamic-factor", help="the hoisting load case: phi2 of a lift-off over "
+                                               "a grid, with EN 13001-2's values",
+                        description=_DYNAMIC_FACTOR_HELP,
+                        formatter_class=argparse.RawDescriptionHelpFormatter)
+    df.add_argument("scene", help="shipped scene name (e.g. crane_lift_off) or TOML path")
+    df.add_argument("--grid", action="append", default=[], metavar="KEY=V1,V2,...",
+                    help="a swept scene key and its values (repeat for more keys)")
+    df.add_argument("--set", action="append", metavar="KEY=VALUE",
+                    help="override a scene value in every cell")
+    df.add_argument("--out", required=True, help="output folder (created)")
+    df.add_argument("--slack", type=float, default=0.05, metavar="M",
+                    help="slack of the hoist rope at the start, m (default: %(default)g)")
+    df.add_argument("--after", type=float, default=1.0, metavar="S",
+                    help="simulated time after the rope is taut, s (default: %(default)g)")
+    df.add_argument("--serial", action="store_true",
+                    help="run the cells one after the other in this process (no Ray)")
+    df.add_argument("--workers", type=int, default=None, metavar="N",
+                    help="at most N cells at a time (Ray)")
+    df.add_argument("--quiet", action="store_true", help="no progress bar")
+    df.set_defaults(func=cmd_dynamic_factor)
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="boom-sim", description=_plain(__doc__.splitlines()[0]),
                                 epilog=_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -382,9 +665,9 @@ def main(argv: list[str] | None = None) -> int:
                         "shorter than that writes none; 0: none); removed once the result is "
                         "written")
     r.add_argument("--resume", action="store_true",
-                   help="continue from OUT/checkpoint.pkl (exit 2 if there is none, or if it "
-                        "was written for another scene); the result equals the uninterrupted "
-                        "run's")
+                   help="continue from OUT/checkpoint.pkl, or start from t = 0 where there "
+                        "is none (exit 2 if it is damaged or was written for another scene); "
+                        "the result equals the uninterrupted run's")
     r.set_defaults(func=cmd_run)
     sw = sub.add_parser("sweep", help="run the Cartesian product of scene overrides as Ray tasks",
                         description=_SWEEP_HELP, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -410,6 +693,8 @@ def main(argv: list[str] | None = None) -> int:
                     help="a case's checkpoint every S wall seconds, which its retry resumes "
                          "from (default: %(default)g; 0: none)")
     sw.set_defaults(func=cmd_sweep)
+    _dynamic_factor_parser(sub)
+    _fmu_parser(sub)
     sub.add_parser("list", help="shipped scenes").set_defaults(func=cmd_list)
     d = sub.add_parser("describe", help="resolved scene, effects and DOF count")
     d.add_argument("scene")
@@ -448,7 +733,16 @@ def main(argv: list[str] | None = None) -> int:
     rp.add_argument("--out", default=None,
                     help="the HTML file (default: report.html beside the result)")
     rp.add_argument("--animation", default=None, metavar="FILE",
-                    help="a GIF or MP4 (boom-sim animate) to embed in the page")
+                    help=f"a GIF or MP4 (boom-sim animate) to embed in the page (default: "
+                         f"{ANIMATION_FILE} beside the result, which run --animate writes, "
+                         f"where there is one)")
+    rp.add_argument("--no-animation", action="store_true",
+                    help=f"no animation in the page, even with {ANIMATION_FILE} beside the "
+                         "result")
+    rp.add_argument("--plotly-beside", action="store_true",
+                    help="load plotly.js from plotly.min.js beside the page (written there) "
+                         "instead of carrying it inside: a small page, one library for a "
+                         "folder of reports")
     rp.set_defaults(func=cmd_report)
     args = p.parse_args(argv)
     try:

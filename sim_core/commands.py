@@ -13,13 +13,15 @@ drive constraint's stabilisation (:mod:`sim_core.systems.telescopic.stepping`).
 ``end`` (optional): the position and rate the actuator has at the end of the ``advance``, as
 the caller's own kinematics have them (e.g. clamped exactly onto an end stop).  They replace the
 segments' state there (a difference of round-off only: more than 1e-9 (1 + |x|) raises
-ValueError) and the actuator coasts on from them.
+CommandError, a ValueError) and the actuator coasts on from them.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+
+from sim_core.errors import CommandError
 
 __all__ = ["Command"]
 
@@ -41,25 +43,25 @@ class Command:
         try:
             segs = tuple(tuple(float(x) for x in s) for s in self.segments)
         except (TypeError, ValueError):
-            raise ValueError(f"segments = {self.segments!r}: a sequence of (acceleration, "
+            raise CommandError(f"segments = {self.segments!r}: a sequence of (acceleration, "
                              "duration, velocity jump) numbers") from None
         if not segs:
-            raise ValueError("segments = (): at least one (acceleration, duration, velocity "
+            raise CommandError("segments = (): at least one (acceleration, duration, velocity "
                              "jump) segment")
         for i, s in enumerate(segs):
             if len(s) != 3:
-                raise ValueError(f"segments[{i}] = {s!r}: (acceleration, duration, velocity "
+                raise CommandError(f"segments[{i}] = {s!r}: (acceleration, duration, velocity "
                                  "jump), three numbers")
             a, tau, jump = s
             last = i == len(segs) - 1
             if not (math.isfinite(a) and math.isfinite(jump)):
-                raise ValueError(f"segments[{i}] = {s!r}: acceleration and velocity jump must "
+                raise CommandError(f"segments[{i}] = {s!r}: acceleration and velocity jump must "
                                  "be finite")
             if not (tau >= 0.0 and (math.isfinite(tau) or last)):
-                raise ValueError(f"segments[{i}] duration = {tau!r} s: allowed [0, inf) "
+                raise CommandError(f"segments[{i}] duration = {tau!r} s: allowed [0, inf) "
                                  "(inf only for the last segment)")
             if math.isinf(tau) and jump != 0.0:
-                raise ValueError(f"segments[{i}] = {s!r}: an endless segment has no velocity "
+                raise CommandError(f"segments[{i}] = {s!r}: an endless segment has no velocity "
                                  "jump at its end")
         object.__setattr__(self, "segments", segs)
         if self.end is not None:
@@ -68,7 +70,7 @@ class Command:
             except (TypeError, ValueError):
                 end = ()
             if len(end) != 2 or not all(math.isfinite(x) for x in end):
-                raise ValueError(f"end = {self.end!r}: (position, rate), two finite numbers")
+                raise CommandError(f"end = {self.end!r}: (position, rate), two finite numbers")
             object.__setattr__(self, "end", end)
 
     @classmethod
@@ -113,11 +115,11 @@ class Command:
         return out, (Command(tuple(segs)) if segs else None)
 
     def check_end(self, s: float, v: float) -> None:
-        """ValueError unless ``end`` agrees with the segments' state (s, v) at the advance's end
-        to END_TOLERANCE (1 + |x|)."""
+        """CommandError (a ValueError) unless ``end`` agrees with the segments' state (s, v) at
+        the advance's end to END_TOLERANCE (1 + |x|)."""
         if self.end is None:
             return
         for name, want, got in (("position", self.end[0], s), ("rate", self.end[1], v)):
             if abs(want - got) > END_TOLERANCE * (1.0 + abs(got)):
-                raise ValueError(f"end {name} = {want!r} differs from the segments' {got!r} by "
+                raise CommandError(f"end {name} = {want!r} differs from the segments' {got!r} by "
                                  f"more than round-off ({END_TOLERANCE:g} (1 + |x|))")

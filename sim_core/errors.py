@@ -9,6 +9,43 @@ class SceneError(ValueError):
     """Invalid scene input; the message names the field, the value and the allowed range."""
 
 
+class CommandError(ValueError):
+    """A bad call of the stepping API (:class:`sim_core.Simulation`): a scene, a step dt, a
+    command, a state snapshot or an output name; the message names the argument, the value and
+    what is allowed."""
+
+
+class UnknownNameError(CommandError, KeyError):
+    """A name the simulation does not have: an actuator in ``advance``'s commands or an output in
+    ``outputs(names)``; the message lists the names it has."""
+
+    def __str__(self) -> str:
+        return str(self.args[0]) if self.args else ""
+
+
+class ActuatorLimitError(CommandError):
+    """A command that would drive an actuator beyond its scene limit (acceleration, rate or end
+    stop) under ``Simulation(scene, limits="raise")``.
+
+    Attributes
+    ----------
+    actuator : str
+        The actuator ("telescopic", "luffing", "slew" or "hoist").
+    quantity : str
+        "acceleration", "rate", "position" or "rate jump".
+    value : float
+        The commanded value (SI: m, m/s, m/s^2 or rad, rad/s, rad/s^2).
+    allowed : tuple[float, float]
+        The allowed range of that quantity, same unit.
+    """
+
+    def __init__(self, message: str, actuator: str, quantity: str, value: float,
+                 allowed: tuple[float, float]):
+        self.actuator, self.quantity = actuator, quantity
+        self.value, self.allowed = float(value), (float(allowed[0]), float(allowed[1]))
+        super().__init__(message)
+
+
 class ResultFormatError(ValueError):
     """A result file (``result.npz``) that :meth:`sim_core.result.Result.load` cannot read: not a
     result file, truncated or corrupted, or written in a result format this version does not
@@ -118,3 +155,48 @@ class SuspectResult(SimulationError):
     def __init__(self, t: float, reason: str, checks: dict, last_state=None):
         self.checks = dict(checks)
         super().__init__(t, reason, last_state=last_state)
+
+
+class WallBudgetExhausted(SimulationError):
+    """The run spent its wall-clock budget ``solver.max_wall_s`` (:class:`sim_core.run_control.
+    RunBudget`: one deadline for the statics, the integration, the outputs, the figures and
+    the report).  The outputs reached so far are attached as ``.result`` where there are any.
+
+    Attributes
+    ----------
+    budget_s : float
+        The budget, s.
+    phase : str
+        The phase that found it spent: ``statics``, ``integration``, ``outputs``,
+        ``figures`` or ``report``.
+    elapsed_s : float
+        Wall seconds spent when it was found, s.
+    """
+
+    def __init__(self, t: float, budget_s: float, phase: str, elapsed_s: float, step=None,
+                 last_state=None):
+        self.budget_s = float(budget_s)
+        self.phase = str(phase)
+        self.elapsed_s = float(elapsed_s)
+        super().__init__(t, f"wall-clock budget solver.max_wall_s = {self.budget_s:g} s "
+                            f"exhausted during the {self.phase} ({self.elapsed_s:.3g} s spent)",
+                         step=step, last_state=last_state)
+
+
+class RunInterrupted(SimulationError):
+    """The user interrupted the run (Ctrl-C: SIGINT, or KeyboardInterrupt in Python); the
+    outputs reached so far are attached as ``.result`` where there are any.
+
+    Attributes
+    ----------
+    phase : str
+        The phase it stopped in (as :class:`WallBudgetExhausted`).
+
+    ``how`` (the message's): ``Ctrl-C`` (the command line's SIGINT handler) or
+    ``KeyboardInterrupt`` (raised in Python code of the run).
+    """
+
+    def __init__(self, t: float, phase: str, step=None, last_state=None, how: str = "Ctrl-C"):
+        self.phase = str(phase)
+        super().__init__(t, f"interrupted by the user ({how}) during the {self.phase}",
+                         step=step, last_state=last_state)

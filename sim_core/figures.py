@@ -7,11 +7,20 @@ from pathlib import Path
 
 import numpy as np
 
+from sim_core import run_control
 from sim_core.result import Result, atomic_write_bytes
 
 
 def save_figure(fig, path: str | Path) -> Path:
-    """fig rendered as PNG in memory and written atomically (sim_core.result.atomic_write_bytes)."""
+    """fig rendered as PNG in memory and written atomically (sim_core.result.atomic_write_bytes).
+    Within a run (``boom-sim run``) the run's wall budget and Ctrl-C are checked first
+    (:func:`sim_core.run_control.check`, phase ``figures``): the figure is closed and the
+    typed error raised."""
+    exc = run_control.current().exceeded("figures")
+    if exc is not None:
+        import matplotlib.pyplot as plt
+        plt.close(fig)
+        raise exc
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=110)
     atomic_write_bytes(path, buf.getvalue())

@@ -7,9 +7,10 @@
 
 Every case is validated before anything is launched (a misspelt key or an out-of-range value
 raises :class:`sim_core.errors.SceneError` naming the case and the field).  Each case runs as a
-Ray task with ``num_cpus=1``: a local Ray started with one CPU per core (``workers`` limits it),
-or an existing cluster (``address``, Ray's own address format, e.g. ``"auto"`` or
-``"ray://head:10001"``; the cluster's Python needs ``sim_core`` installed).  The task returns the
+Ray task with ``num_cpus=1``: a local Ray started with one CPU per core (``workers`` limits it)
+whose services listen on 127.0.0.1 only, or an existing cluster (``address``, Ray's own address
+format, e.g. ``"auto"`` or ``"ray://head:10001"``; the cluster's Python needs ``sim_core``
+installed).  The task returns the
 :class:`sim_core.result.Result` to the driver, which writes the case folder, so a cluster needs no
 shared file system.
 
@@ -421,17 +422,23 @@ def _cell(v) -> str:
     return str(v)
 
 
-def write_summary(out: Path, rows: list[dict], keys: list[str], title: str) -> list[Path]:
-    """summary.csv, summary.parquet (if pyarrow is importable) and summary.png, each written
-    atomically.  Returns the paths written."""
-    fields = summary_fields(rows, keys)
+def csv_bytes(rows: list[dict], fields: list[str], cell) -> bytes:
+    """The rows as CSV text (a header of ``fields``, then each row's ``cell(value)`` of every
+    field), encoded UTF-8."""
     buf = io.StringIO(newline="")
     w = csv.DictWriter(buf, fields)
     w.writeheader()
     for r in rows:
-        w.writerow({k: _cell(r.get(k)) for k in fields})
+        w.writerow({k: cell(r.get(k)) for k in fields})
+    return buf.getvalue().encode()
+
+
+def write_summary(out: Path, rows: list[dict], keys: list[str], title: str) -> list[Path]:
+    """summary.csv, summary.parquet (if pyarrow is importable) and summary.png, each written
+    atomically.  Returns the paths written."""
+    fields = summary_fields(rows, keys)
     paths = [out / "summary.csv"]
-    atomic_write_bytes(paths[0], buf.getvalue().encode())
+    atomic_write_bytes(paths[0], csv_bytes(rows, fields, _cell))
     try:
         import pyarrow as pa
         import pyarrow.parquet as pq
@@ -532,9 +539,10 @@ def _check_reachable(address: str, timeout: float = 5.0) -> None:
 
 def _start_ray(address: str | None, workers: int | None):
     """-> (ray module, whether this call started Ray).  An already initialised Ray is used as
-    it is.  Without ``address`` a new local Ray with one CPU per core, or ``workers`` CPUs
-    (never a cluster found on this machine: ``address="auto"`` joins that); ``address``: join
-    that cluster.  Ray's own logging is kept to errors and worker output is not forwarded."""
+    it is.  Without ``address`` a new local Ray with one CPU per core, or ``workers`` CPUs,
+    listening on 127.0.0.1 only (:func:`_init_loopback_ray`; never a cluster found on this
+    machine: ``address="auto"`` joins that); ``address``: join that cluster.  Ray's own
+    logging is kept to errors and worker output is not forwarded."""
     import logging
     try:
         import ray
@@ -550,11 +558,43 @@ def _start_ray(address: str | None, workers: int | None):
         if address:
             ray.init(address=address, **kw)
         else:       # "local": a new Ray here, even where a cluster runs or RAY_ADDRESS is set
-            ray.init(address="local", num_cpus=workers, **kw)
+            _init_loopback_ray(ray, num_cpus=workers, **kw)
     except (ConnectionError, ValueError, RuntimeError) as exc:
         where = f"--address {address!r}" if address else "local Ray"
         raise SweepError(f"{where}: cannot start or join Ray: {_one_line(exc)}") from None
     return ray, True
+
+
+LOOPBACK = "127.0.0.1"
+
+
+def _init_loopback_ray(ray, **kw) -> None:
+    """A new local Ray whose services (GCS, raylet, object manager, workers, agents) listen
+    on 127.0.0.1 only.  Every Ray process binds its gRPC and HTTP servers to the node's IP
+    address, and on Linux ``ray.init`` replaces a loopback ``_node_ip_address`` by the
+    machine's routable address unless Ray's ``ENABLE_RAY_CLUSTER`` switch is off (the switch
+    of its single-machine platforms): the switch is off while this node starts, so the node's
+    address stays 127.0.0.1 and is handed to every process Ray starts.  A Ray that still
+    comes up on another address is shut down (SweepError): a local sweep never listens on
+    the network."""
+    try:
+        from ray._private import ray_constants
+    except ImportError:               # another layout: the address check below decides
+        ray_constants = None
+    before = getattr(ray_constants, "ENABLE_RAY_CLUSTER", None)
+    if before is not None:
+        ray_constants.ENABLE_RAY_CLUSTER = False
+    try:
+        ray.init(address="local", _node_ip_address=LOOPBACK, dashboard_host=LOOPBACK, **kw)
+    finally:
+        if before is not None:
+            ray_constants.ENABLE_RAY_CLUSTER = before
+    ip = ray.util.get_node_ip_address()
+    if ip != LOOPBACK:
+        ray.shutdown()
+        raise SweepError(f"local Ray: it started on {ip}, not on {LOOPBACK} only (this Ray "
+                         "version ignores the loopback address); pass --address to use a "
+                         "cluster deliberately")
 
 
 def run_sweep(scene: str | Path, grid: dict[str, list] | None, out: str | Path, *,

@@ -29,13 +29,19 @@ Point data (they describe the boom lines; the other points carry ``boom`` = -1 a
 line from its start, summed from the point spacing), ``curvature`` (1/m, the turning angle
 between consecutive segments over their mean length, 0 at the ends: :func:`discrete_curvature`)
 and ``e_t``, ``e_b``, ``e_s`` (the section frame: bending axes and boom axis, global unit vectors,
-for glyphs).
+for glyphs).  With section forces in the result (``section_forces``): ``section_force``
+((N, Q_t, Q_b), N) and ``section_moment`` ((T, M_t, M_b), N m), section-frame components,
+``section_von_mises`` (Pa, the largest von Mises stress over the section's outline points, NaN
+for a section without geometry) and ``section_utilisation`` (that over ``material.f_y``), each
+interpolated linearly in the material coordinate from the stations of ``section_stations``.
 
 Cell data (every name on every block, zeros where it does not apply): ``part`` (0 boom,
 1 luffing cylinder, 2 hoist rope, 3 contact point, 4 payload), ``force`` (N: the luffing
 cylinder's force on its cell, the hoist rope's force on its cell), ``contact_force`` (N) and
 ``contact_moment`` (N m) on the contact points, and with a slider-spring distribution in the
-result ``slider_force`` (N, the sum of the region's slider spring normal forces).  The contact
+result ``slider_force`` (N, the sum of the region's slider spring normal forces) and, with
+``pad_forces``, ``pad_force`` (N, global components: the force of the pad at that contact point
+on the overlap's inner boom; the inner pad at the inner point, the outer pad at the outer one).  The contact
 loads are ``contact_point_forces``, given in the section frame (s, t, b) of the boom the point
 lies on (the inner point on the outer boom k, the outer point on boom k + 1), turned to global
 components with that boom's frame at its centre-line point nearest to the contact point:
@@ -188,6 +194,13 @@ def _frame_arrays(result) -> dict:
             lines, out["frames"], out["contacts"], cpf)
     else:
         out["contact_force"] = out["contact_moment"] = np.zeros((n, 0, 2, 3))
+    if "pad_forces" in keys and n_pairs:
+        # the pads (outer pad: region II on boom k + 1; inner pad: region I on boom k) as
+        # contact loads (force (s, t, b), no moment) of the contact points (k, 1) and (k, 0)
+        pf = get("pad_forces", (n, n_pairs, 2, 2))
+        pads = np.zeros((n, n_pairs, 2, 6))
+        pads[:, :, 0, 1:3], pads[:, :, 1, 1:3] = pf[:, :, 1], pf[:, :, 0]
+        out["pad_force"] = contact_loads_global(lines, out["frames"], out["contacts"], pads)[0]
     if "slider_contact_forces" in keys and n_pairs:
         scf = np.asarray(result["slider_contact_forces"], dtype=float)
         if scf.ndim != 3 or scf.shape[:2] != (n, 2 * n_pairs):
@@ -202,6 +215,34 @@ def _frame_arrays(result) -> dict:
     out["s"] = np.concatenate([np.zeros((n, N, 1)), np.cumsum(
         np.linalg.norm(np.diff(lines, axis=2), axis=-1), axis=2)], axis=2)
     out["curvature"] = discrete_curvature(lines)
+    if "section_forces" in keys:
+        out.update(_section_point_data(result, n, N, P))
+    return out
+
+
+def _section_point_data(result, n: int, N: int, P: int) -> dict:
+    """The section forces, the largest von Mises stress and the utilisation at the centre-line
+    points: linear in the material coordinate between the stations (``section_stations``);
+    the centre-line points are equally spaced from s = 0 to the boom's length, as the
+    stations."""
+    st = np.asarray(result["section_stations"], dtype=float)
+    forces = np.asarray(result["section_forces"], dtype=float)
+    if st.ndim != 2 or st.shape[0] != N or forces.shape != (n, N, st.shape[1], 6):
+        raise ValueError(f"section_forces has shape {forces.shape} and section_stations "
+                         f"{st.shape}, expected (n, N, S, 6) and (N, S) with n = {n}, N = {N}")
+    stress = np.asarray(result["section_stress"], dtype=float)
+    vm = np.sqrt(stress[..., 0] ** 2 + 3.0 * stress[..., 1] ** 2)
+    vm = np.where(np.isnan(vm).all(axis=-1), np.nan, np.nanmax(
+        np.where(np.isnan(vm), -np.inf, vm), axis=-1))
+    util = np.asarray(result["section_utilisation"], dtype=float)
+    out = {"section_forces": np.empty((n, N, P, 6)), "section_von_mises": np.empty((n, N, P)),
+           "section_utilisation": np.empty((n, N, P))}
+    for k in range(N):
+        s_pts = np.linspace(0.0, st[k, -1], P)
+        W = np.stack([np.interp(s_pts, st[k], e) for e in np.eye(st.shape[1])], axis=1)
+        out["section_forces"][:, k] = np.einsum("ps,nsc->npc", W, forces[:, k])
+        out["section_von_mises"][:, k] = vm[:, k] @ W.T
+        out["section_utilisation"][:, k] = util[:, k] @ W.T
     return out
 
 
@@ -226,6 +267,12 @@ def _frame_mesh(meshio, f: dict, i: int):
                   "curvature": pdata(f["curvature"][i]),
                   "e_t": pdata(frames[..., 0, :], (3,)), "e_b": pdata(frames[..., 1, :], (3,)),
                   "e_s": pdata(frames[..., 2, :], (3,))}
+    if "section_forces" in f:
+        sf = f["section_forces"][i]
+        point_data.update({"section_force": pdata(sf[..., :3], (3,)),
+                           "section_moment": pdata(sf[..., 3:], (3,)),
+                           "section_von_mises": pdata(f["section_von_mises"][i]),
+                           "section_utilisation": pdata(f["section_utilisation"][i])})
 
     # vertex block: contact points, then the payload
     first_contact = n_boom + n_cyl
@@ -257,6 +304,8 @@ def _frame_mesh(meshio, f: dict, i: int):
     cell_data = {"part": [v_part, l_part], "force": [np.zeros(n_v), l_force],
                  "contact_force": vector_block(f["contact_force"][i]),
                  "contact_moment": vector_block(f["contact_moment"][i])}
+    if "pad_force" in f:
+        cell_data["pad_force"] = vector_block(f["pad_force"][i])
     if "slider_force" in f:
         sf = np.zeros(n_v)
         sf[:n_contacts] = f["slider_force"][i].ravel()

@@ -8,7 +8,8 @@ the checkpoint holds the integrator's whole state (scipy's solver objects withou
 callables, the RK45/BDF switch, generalized-alpha's state, the model's warm starts), so the
 resumed process takes exactly the same steps.  The runs are real ``boom-sim`` processes,
 killed from outside once a checkpoint past a third of the run is on disk.  Also: a resume
-of a changed scene, a missing, truncated or corrupt checkpoint exit with status 2 and one
+of a changed scene, a missing, truncated or corrupt checkpoint, or one whose body has a valid
+checksum but not the structure its integration path writes, exit with status 2 and one
 line; a writer killed half-way through a checkpoint leaves the previous one whole.
 """
 
@@ -282,12 +283,19 @@ def test_resume_of_a_changed_scene_is_refused(checkpointed, capsys):
     assert not (checkpointed / "result.npz").exists()
 
 
-def test_resume_without_a_checkpoint_is_refused(tmp_path, capsys):
-    out = tmp_path / "empty"
-    assert cli.main(["run", *BEAM, "--out", str(out), "--quiet", "--no-plots", "--no-report",
-                     "--resume"]) == 2
-    _one_line_error(capsys, "no checkpoint to resume from")
-    assert not (out / "result.npz").exists()
+def test_resume_without_a_checkpoint_starts_from_zero(tmp_path, capsys):
+    """--resume where no checkpoint exists runs from t = 0, says so, and gives the result of
+    the same run without --resume."""
+    args = ["run", *BEAM, "--quiet", "--no-plots", "--no-report"]
+    assert cli.main([*args, "--out", str(tmp_path / "empty"), "--resume"]) == 0
+    err = capsys.readouterr().err
+    assert "no checkpoint in" in err and "starting from t = 0" in err
+    assert cli.main([*args, "--out", str(tmp_path / "plain")]) == 0
+    resumed = Result.load(tmp_path / "empty" / "result.npz")
+    plain = Result.load(tmp_path / "plain" / "result.npz")
+    assert np.array_equal(resumed.t, plain.t) and resumed.t[-1] == 0.02
+    for name in plain.outputs:
+        np.testing.assert_array_equal(resumed[name], plain[name], err_msg=name)
 
 
 @pytest.mark.parametrize("damage", ["truncated", "flipped", "garbage", "foreign object"])
@@ -314,6 +322,74 @@ def test_damaged_checkpoint_is_a_typed_one_line_error(checkpointed, capsys, dama
     line = _one_line_error(capsys)
     assert any(w in line for w in ("truncated or corrupt", "not a boom-sim checkpoint",
                                    "corrupt body")), line
+
+
+def _malform(payload: dict, damage: str) -> dict:
+    """The beam's checkpoint body (numpy generalized-alpha, error control) with one kind of
+    damage that a correct checksum over it does not reveal."""
+    st = payload["state"]
+    if damage == "state missing a key":
+        del st["ga"]
+    elif damage == "nested key missing":
+        del st["ga"]["ga"]["q"]
+    elif damage == "number as text":
+        st["wall_s"] = "12"
+    elif damage == "time not finite":
+        payload["t"] = float("nan")
+    elif damage == "unknown path":
+        payload["driver"] = "euler"
+    elif damage == "state a list":
+        payload["state"] = [1, 2]
+    elif damage == "array of another length":
+        st["ga"]["ga"]["v"] = np.zeros(st["ga"]["ga"]["q"].size + 1)
+    elif damage == "integers for floats":
+        st["shim_y"] = st["shim_y"].astype(np.int64)
+    elif damage == "matrix for a vector":
+        st["stall"]["times"] = np.zeros((3, 3))
+    elif damage == "output rows of the wrong shape":
+        st["ga"]["out"]["ys"] = [(np.zeros(2),) * 3]
+    return payload
+
+
+@pytest.mark.parametrize("damage", [
+    "state missing a key", "nested key missing", "number as text", "time not finite",
+    "unknown path", "state a list", "array of another length", "integers for floats",
+    "matrix for a vector", "output rows of the wrong shape"])
+def test_a_malformed_body_with_a_valid_checksum_is_a_one_line_refusal(checkpointed, capsys,
+                                                                      damage):
+    """A body that unpickles (numbers, containers, arrays) under a correct checksum but does
+    not have the structure its integration path writes: refused with the damaged files'
+    error (exit 2, one line naming what is wrong), never a traceback."""
+    path = checkpointed / "checkpoint.pkl"
+    data = encode(_malform(decode(path.read_bytes(), path), damage))
+    path.write_bytes(data)
+    with pytest.raises(CheckpointError, match="corrupt body") as err:
+        decode(data, path)
+    assert "\n" not in str(err.value)
+    args = ["run", *BEAM, "--out", str(checkpointed), "--quiet", "--no-plots", "--no-report",
+            "--resume"]
+    assert cli.main(args) == 2
+    _one_line_error(capsys, "corrupt body", "remove it and run without --resume")
+    assert not (checkpointed / "result.npz").exists()
+
+
+def test_a_restored_solver_attribute_keeps_its_shape_and_kind(tmp_path):
+    """scipy's solver state is put back attribute by attribute: an array of another shape or
+    kind, or text for a number, is refused before anything is set."""
+    class Solver:
+        def __init__(self):
+            self.y, self.h_abs, self.status = np.zeros(4), 0.1, "running"
+
+    for bad in ({"y": np.zeros(5)}, {"y": np.zeros(4, dtype=np.int64)}, {"y": [0.0] * 4},
+                {"h_abs": "0.1"}, {"h_abs": np.zeros(2)}):
+        s = Solver()
+        with pytest.raises(CheckpointError, match="corrupt body"):
+            ck.restore_object_state(s, {"status": "failed", **bad})
+        assert s.status == "running"            # nothing set
+    s = Solver()
+    ck.restore_object_state(s, {"y": np.ones(4), "h_abs": np.float64(0.2), "status": "done",
+                                "h_previous": 0.05})
+    assert s.y.tolist() == [1.0] * 4 and s.h_abs == 0.2 and s.h_previous == 0.05
 
 
 def test_a_pickled_function_never_loads(tmp_path):

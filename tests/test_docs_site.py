@@ -8,9 +8,10 @@ from the internet fails to load.  For every page:
 
 * the browser console has no SEVERE entry (a failed resource, a script error);
 * every resource the page loaded came from the local server;
-* no table is wider than the article's content column: every table's right edge lies within
-  the article's, no table scrolls sideways in the theme's scroll wrapper and the page does
-  not scroll sideways (collapsed notes opened, so their tables count too);
+* no table's box is wider than the article's content column: every table's scroll wrapper
+  (the theme's, in which a wide table scrolls sideways) ends within the article, no code span
+  in a table breaks across lines and the page does not scroll sideways (collapsed notes
+  opened, so their tables count too);
 * every row of every table has as many cells as its header row (colspans counted).
 
 The gallery's reports are loaded too and checked for console errors and local resources.
@@ -120,7 +121,6 @@ const cells = row => Array.from(row.cells).reduce((n, c) => n + (c.colSpan || 1)
 const out = {pageScroll: page.scrollWidth, pageWidth: page.clientWidth, right: box.right,
              tables: []};
 art.querySelectorAll('table').forEach((t, k) => {
-  const r = t.getBoundingClientRect();
   const rows = Array.from(t.rows);
   const head = t.tHead && t.tHead.rows.length ? t.tHead.rows[0] : rows[0];
   const width = head ? cells(head) : 0;
@@ -128,8 +128,15 @@ art.querySelectorAll('table').forEach((t, k) => {
                   .map(row => row.innerText.slice(0, 100));
   const caption = (head ? head.innerText : '').replace(/\\s+/g, ' ').slice(0, 80);
   const wrap = t.closest('.md-typeset__scrollwrap');
-  out.tables.push({index: k, right: r.right, header: caption, columns: width, bad: bad,
-                   wrapScroll: wrap ? wrap.scrollWidth - wrap.clientWidth : 0});
+  const broken = Array.from(t.querySelectorAll('td code, th code'))
+                      .filter(c => c.getClientRects().length > 1).map(c => c.innerText);
+  // the wrapper's right edge less its (negative) right margin: the theme lets it reach into
+  // the article's padding by that margin, for the scroll shadow
+  const right = wrap ? wrap.getBoundingClientRect().right
+                       + (parseFloat(getComputedStyle(wrap).marginRight) || 0)
+                     : t.getBoundingClientRect().right;
+  out.tables.push({index: k, right: right, header: caption, columns: width, bad: bad,
+                   broken: broken});
 });
 return out;
 """
@@ -177,9 +184,9 @@ def _check(driver, base: str, page: str, tables: bool) -> list[str]:
         problems.append(f"{page}: the page scrolls sideways ({geo['pageScroll']} px of "
                         f"content in a {geo['pageWidth']} px window)")
     for t in geo["tables"]:
-        if t["wrapScroll"] > 1:
-            problems.append(f"{page}: table {t['index']} ({t['header']}) scrolls sideways "
-                            f"by {t['wrapScroll']} px")
+        for code in t["broken"]:
+            problems.append(f"{page}: table {t['index']} ({t['header']}): code span "
+                            f"{code!r} breaks across lines")
         if t["right"] > geo["right"] + 1:
             problems.append(f"{page}: table {t['index']} ({t['header']}) ends "
                             f"{t['right'] - geo['right']:.0f} px right of the content column")

@@ -32,6 +32,16 @@ takes seconds.  The flexible telescopic scenes (``telescopic_extraction``,
 a run of theirs takes seconds to minutes.  ``test_wall_budget_is_honoured_on_every_path`` runs
 each integration path once with a run that would take minutes to hours and a 0.5 s budget.
 
+Every shipped scene (``sim_core/scenes/*.toml``, the crane scenes included) is also drawn
+with two or three keys at once (``test_shipped_scenes_with_two_or_three_keys_*``): mostly keys
+of its arrays of tables (``boom.2.length``, ``overlap.1.radial_gap``: an index the scene has),
+its ``[luffing]``, drive and effect plug-in tables (``[wind]``, ``[oil_column]``, switched on),
+and drive tables replaced by rows inline or by a CSV file written next to a copy of the scene.
+Each valid example runs (``solver.t_end`` at most ``RUN_T_END``, ``solver.max_wall_s =
+RUN_BUDGET``) and must end -- a SceneError, a typed SimulationError or a result with finite
+outputs -- within ``RUN_BUDGET + RUN_MARGIN`` of wall time in all.  The default run draws 30
+examples, the slow one 300.
+
 The default run draws 800 examples from a fixed seed (``FUZZ_SEED`` in the environment
 replaces it, so a failure reproduces with the seed printed in the summary); the slow test draws
 5000.  The summary line (seed and the count of each outcome) is written to the terminal at the
@@ -56,6 +66,7 @@ from hypothesis import strategies as st
 import sim_core
 from sim_core.errors import SceneError, SimulationError
 from sim_core.scene.fields import Field, Schema
+from sim_core.scene.io import shipped_scenes
 from sim_core.systems.beam.schema import SCHEMA as BEAM
 from sim_core.systems.folding.schema import SCHEMA as FOLDING
 from sim_core.systems.telescopic.schema import SCHEMA as TELESCOPIC
@@ -224,6 +235,15 @@ def _finite_outputs(res) -> bool:
     return bool(np.all(np.isfinite(res.t)))
 
 
+def _cap(over: dict, caps, base: dict) -> None:
+    """Each (key, cap): a drawn number in (0, cap] stays, else the base's value (at most the
+    cap) replaces it."""
+    for key, cap in caps:
+        v = over.get(key)
+        if not (isinstance(v, (int, float)) and not isinstance(v, bool) and 0 < v <= cap):
+            over[key] = min(base.get(key, cap), cap)
+
+
 def check_example(name: str, overrides: dict, run: bool) -> str:
     """Validate (and run) one example; returns its outcome, fails on any other."""
     schema, base, t_cap = SCENES[name]
@@ -233,11 +253,8 @@ def check_example(name: str, overrides: dict, run: bool) -> str:
         # the run stays short and budgeted whatever was drawn: t_end, the budget and the
         # outputs (evaluated after the integration, outside its budget) at most their caps,
         # else the cheap base's (or the cap)
-        for key, cap in (("solver.t_end", t_cap), ("solver.max_wall_s", BUDGET),
-                         ("solver.n_output", 50)):
-            v = over.get(key)
-            if not (isinstance(v, (int, float)) and not isinstance(v, bool) and 0 < v <= cap):
-                over[key] = min(base.get(key, cap), cap)
+        _cap(over, (("solver.t_end", t_cap), ("solver.max_wall_s", BUDGET),
+                    ("solver.n_output", 50)), base)
     try:
         sc = sim_core.load_scene(scene, overrides=over)
     except SceneError as exc:
@@ -271,15 +288,17 @@ def check_example(name: str, overrides: dict, run: bool) -> str:
     return "Result (suspect)" if res.suspect else "Result"
 
 
-def _run(name, overrides, run):
+def _run(name, overrides, run, check=check_example, label=""):
+    """check(name, overrides, run) and count its outcome; any untyped exception fails,
+    naming the example."""
     try:
-        outcome = check_example(name, overrides, run)
+        outcome = check(name, overrides, run)
     except (SceneError, SimulationError, AssertionError):
         raise
     except Exception as exc:       # noqa: BLE001 - the point of the test: name what escaped
         raise AssertionError(f"untyped {type(exc).__name__} from {name} with {overrides!r} "
-                             f"(run: {run}): {exc}") from exc
-    OUTCOMES[outcome] += 1
+                             f"(run / csv rows: {run}): {exc}") from exc
+    OUTCOMES[label + outcome] += 1
 
 
 FAST = settings(max_examples=800, deadline=None, database=None, derandomize=False,
@@ -365,3 +384,160 @@ def test_cli_refuses_a_payload_outside_the_modal_tables_with_one_line(tmp_path):
     assert len(lines) == 1, proc.stderr
     assert "payload.mass = 7.0" in lines[0] and "[20000, 30000] kg" in lines[0], lines[0]
     assert not (tmp_path / "out").exists()
+
+
+# -- every shipped scene, two or three keys at once, run under a wall budget -------------------
+
+RUN_BUDGET = 5.0             # s: solver.max_wall_s of every run of a shipped scene
+RUN_MARGIN = 5.0
+"""s past RUN_BUDGET that loading, validating and running one example may take: the margin
+docs/user_guide.md states for a run ("Budgets and interruption": the budget covers the static
+equilibrium, the integration, the output collection and the self-checks, each checked between
+units of work, and a unit in progress finishes), which also covers loading and validating the
+scene (milliseconds)."""
+RUN_T_END = 0.05             # s: the longest solver.t_end of a run (a few steps of each scene)
+RUN_OUTPUTS = 5              # the most outputs of a run
+ACTUATORS = ("drive", "luffing_drive", "slew_drive", "hoist_drive")
+FOCUS = ("boom[]", "boom[].section", "overlap[]", "luffing", "stage_drive[]", "wind",
+         "oil_column", "beams[]", "beams[].section", "boundary[]", *ACTUATORS)
+SCHEMAS = {"beam": BEAM, "telescopic": TELESCOPIC, "folding": FOLDING}
+_RAW: dict = {}
+
+
+def shipped(name: str) -> tuple[dict, Schema]:
+    """A shipped scene's raw table and its kind's schema (read once)."""
+    if name not in _RAW:
+        from sim_core.registry import kind_name
+        from sim_core.scene.io import read_scene
+        raw, _ = read_scene(name)
+        _RAW[name] = (raw, SCHEMAS[kind_name(raw)])
+    return _RAW[name]
+
+
+def _rows(f: Field, first=None):
+    """Rows [time, position] of a drive table, times increasing from 0 past RUN_T_END and
+    positions in the column's range (the first one ``first`` where the scene fixes it)."""
+    (t_lo, t_hi, _), (p_lo, p_hi, _) = f.columns
+    pos = st.floats(p_lo, min(p_hi, p_lo + 1e3), allow_nan=False)
+    times = st.lists(st.floats(1e-3, 2 * RUN_T_END), min_size=1, max_size=4, unique=True)
+    return st.tuples(times, st.lists(pos, min_size=5, max_size=5)).map(
+        lambda tp: [[0.0, first if first is not None else tp[1][0]]]
+        + [[t, p] for t, p in zip(sorted(tp[0]), tp[1][1:])])
+
+
+def _inside(f: Field):
+    """A value of a declared key inside its range (or of its type), most examples of a
+    shipped scene then run."""
+    if f.type in ("number", "integer"):
+        lo, hi = f.lo, f.hi
+        return (st.integers(int(math.ceil(lo)), int(math.floor(hi))) if f.type == "integer"
+                else st.floats(lo, hi, allow_nan=False, allow_infinity=False))
+    return values(f)
+
+
+@st.composite
+def shipped_examples(draw):
+    """(scene, overrides, csv rows or None): two or three drawn keys of a shipped scene, mostly
+    in its arrays of tables (at an index the scene has), its luffing, drive and effect tables;
+    sometimes a drive table replaced by rows inline or by a CSV file (written next to a copy of
+    the scene), or an effect plug-in switched on with a key of its table."""
+    name = draw(st.sampled_from(sorted(shipped_scenes())))
+    raw, schema = shipped(name)
+    keys = declared_keys(schema)
+    # the focus tables the scene has (an effect plug-in's table is switched on below)
+    focus = [(f"{t.path.replace('[]', '.0')}.{f.key}", f) for t in schema.tables
+             if t.path in FOCUS and (t.path.split("[]")[0].split(".")[0] in raw
+                                     or t.path in ("wind", "oil_column"))
+             for f in t.fields] or keys
+    overrides, csv = {}, None
+    for _ in range(draw(st.integers(2, 3))):
+        pick = draw(st.integers(0, 9))
+        if pick < 6 or schema is not TELESCOPIC:
+            key, f = draw(st.sampled_from(focus if pick < 4 else keys))
+            parts = key.split(".")
+            if len(parts) > 2 and parts[1] == "0" and isinstance(raw.get(parts[0]), list):
+                parts[1] = str(draw(st.integers(0, max(len(raw[parts[0]]) - 1, 0))))
+            overrides[".".join(parts)] = draw(_inside(f) if draw(st.integers(0, 3)) else values(f))
+            if parts[0] in ("wind", "oil_column"):
+                overrides[f"effects.{parts[0]}"] = True
+        elif pick < 8:
+            table = draw(st.sampled_from(ACTUATORS))
+            f = schema.table(table)["table"]
+            first = raw.get("booms", {}).get("stroke0") if table == "drive" else None
+            rows = draw(_rows(f, first))
+            extra = {"direction": raw.get("drive", {}).get("direction", "extraction")} \
+                if table == "drive" else {}
+            if draw(st.booleans()):
+                overrides[table] = {"profile": "table", "table": rows, **extra}
+            else:
+                overrides[table] = {"profile": "table", "table_file": "fuzz_drive.csv", **extra}
+                csv = rows
+        else:
+            plugin = draw(st.sampled_from(("wind", "oil_column")))
+            f = draw(st.sampled_from(schema.table(plugin).fields))
+            overrides[f"effects.{plugin}"] = True
+            overrides[f"{plugin}.{f.key}"] = draw(values(f))
+    return name, overrides, csv
+
+
+def check_shipped(name: str, overrides: dict, csv) -> str:
+    """Validate and run one example of a shipped scene (copied into a temporary folder with
+    the drive's CSV file where one was drawn) at most RUN_T_END long under RUN_BUDGET; returns
+    its outcome, fails on any other: a run that returns must have finite outputs, and the
+    whole example must end within RUN_BUDGET + RUN_MARGIN."""
+    import shutil
+    import tempfile
+    over = dict(overrides)
+    _cap(over, (("solver.t_end", RUN_T_END), ("solver.n_output", RUN_OUTPUTS)), {})
+    over["solver.max_wall_s"] = RUN_BUDGET
+    schema = shipped(name)[1]
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / f"{name}.toml"
+        shutil.copyfile(shipped_scenes()[name], path)
+        if csv is not None:
+            (Path(tmp) / "fuzz_drive.csv").write_text(
+                "time_s,position\n" + "".join(f"{t!r},{p!r}\n" for t, p in csv))
+        t0 = time.perf_counter()
+        try:
+            sc = sim_core.load_scene(path, overrides=over)
+        except SceneError as exc:
+            msg = str(exc)
+            assert msg and "\n" not in msg, (name, over, msg)
+            assert _names_a_field(msg, schema.kind) or tmp in msg, (name, over, msg)
+            return "SceneError"
+        try:
+            res = sim_core.simulate(sc)
+            outcome = "Result (suspect)" if res.suspect else "Result"
+        except SimulationError as exc:
+            assert math.isfinite(exc.t) and exc.t >= 0.0, (name, over, exc)
+            outcome = f"SimulationError ({type(exc).__name__})"
+            res = None
+        wall = time.perf_counter() - t0
+    assert wall <= RUN_BUDGET + RUN_MARGIN, (name, over, wall)
+    if res is not None:
+        assert _finite_outputs(res), (name, over, res.stats)
+        assert res.t[-1] == pytest.approx(sc["solver"]["t_end"]), (name, over)
+    return outcome
+
+
+def _run_shipped(name, overrides, csv):
+    _run(name, overrides, csv, check_shipped, "shipped: ")
+
+
+SHIPPED_FAST = settings(FAST, max_examples=30)
+SHIPPED_SLOW = settings(FAST, max_examples=300)
+
+
+@seed(SEED + 2)
+@SHIPPED_FAST
+@given(example=shipped_examples())
+def test_shipped_scenes_with_two_or_three_keys_end_within_their_budget(example):
+    _run_shipped(*example)
+
+
+@pytest.mark.slow
+@seed(SEED + 3)
+@SHIPPED_SLOW
+@given(example=shipped_examples())
+def test_shipped_scenes_with_two_or_three_keys_many(example):
+    _run_shipped(*example)

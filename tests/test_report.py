@@ -107,12 +107,30 @@ def test_the_default_report_is_one_self_contained_file(tmp_path):
     assert "/somewhere" not in text and '"solver": {' in page.text
 
 
-def test_one_plot_per_output_with_a_stable_id(tmp_path):
+def plotted(res: Result) -> list[str]:
+    """The outputs with a plot of their own: all but the integrator state and the replay
+    geometry (and the per-station section arrays, which result_of_every_shape lacks)."""
+    return [n for n in res.outputs if n != "state" and not n.startswith("geometry_")]
+
+
+def test_one_plot_per_time_series_with_a_stable_id(tmp_path):
     res = result_of_every_shape()
     page = parse(rp.write_report(res, tmp_path / "report.html"))
-    assert [p["id"] for p in page.plots] == [f"plot-{name}" for name in res.outputs]
-    assert [p["data-output"] for p in page.plots] == list(res.outputs)
-    assert "Plots (8)" in page.text
+    assert [p["id"] for p in page.plots] == [f"plot-{name}" for name in plotted(res)]
+    assert [p["data-output"] for p in page.plots] == plotted(res)
+    assert "Plots (5)" in page.text
+
+
+def test_state_and_replay_geometry_are_listed_not_plotted(tmp_path):
+    res = result_of_every_shape()
+    path = rp.write_report(res, tmp_path / "report.html")
+    page, text = parse(path), path.read_text(encoding="utf-8")
+    for name in ("state", "geometry_centre_lines", "geometry_section_outlines"):
+        assert f'id="plot-{name}"' not in text and f'data-output="{name}"' not in text
+        # in the index, linked to its row of the table of outputs without a plot
+        assert f'<a href="#out-{name}">' in text and f'<tr id="out-{name}">' in text
+    assert "replay geometry: drawn by the animation" in page.text
+    assert "the integrator state" in page.text
 
 
 def test_summary_and_self_checks_are_in_the_page(tmp_path):
@@ -319,10 +337,10 @@ def test_boom_sim_report_writes_the_report_beside_the_result(tmp_path, capsys):
     res.save(tmp_path / "result.npz")
     assert cli.main(["report", str(tmp_path / "result.npz")]) == 0
     assert f"wrote {tmp_path / 'report.html'}" in capsys.readouterr().out
-    assert len(parse(tmp_path / "report.html").plots) == len(res.outputs)
+    assert len(parse(tmp_path / "report.html").plots) == len(plotted(res))
     out = tmp_path / "elsewhere" / "r.html"
     assert cli.main(["report", str(tmp_path / "result.npz"), "--out", str(out)]) == 0
-    assert len(parse(out).plots) == len(res.outputs)
+    assert len(parse(out).plots) == len(plotted(res))
 
 
 @pytest.mark.parametrize("content, fragment", [
@@ -361,9 +379,159 @@ def test_boom_sim_run_writes_the_report_unless_told_not_to(tmp_path, monkeypatch
     assert cli.main([*args, "--out", str(out)]) == 0
     assert "report.html" in capsys.readouterr().out
     page = parse(out / "report.html")
-    assert len(page.plots) == len(result_of_every_shape().outputs)
+    assert len(page.plots) == len(plotted(result_of_every_shape()))
     assert json.loads((out / "summary.json").read_text())["n_steps"] == 120
     out2 = tmp_path / "out2"
     assert cli.main([*args, "--out", str(out2), "--no-report"]) == 0
     assert "report.html" not in capsys.readouterr().out
     assert not (out2 / "report.html").exists() and (out2 / "result.npz").exists()
+
+
+# -- the shipped scenes' reports: what is plotted, every component named, the page's size ----
+
+REAL_SCENES = ("telescopic_extraction", "crane_hexagonal_4")
+
+
+@pytest.fixture(scope="module")
+def shipped_runs():
+    """The first 0.1 s of two shipped scenes with every output of the telescopic kind (replay
+    geometry, section forces, pads, ropes), with their 201 output times as shipped."""
+    from sim_core import load_scene, simulate
+    return {name: simulate(load_scene(name, overrides={"solver.t_end": 0.1}))
+            for name in REAL_SCENES}
+
+
+def _figures(res: Result):
+    """(output name, figure) of every output the page plots, as the page draws them."""
+    page = rp._plots_section(res, enveloped=True)[0]
+    names = re.findall(r'data-output="([^"]+)"', page)
+    t = np.asarray(res.t, dtype=float)
+    return [(n, rp._figure(n, np.asarray(res[n], dtype=float), t, rp._UNITS.get(n, ""),
+                           scene=res.scene)[0]) for n in names]
+
+
+@pytest.mark.parametrize("scene", REAL_SCENES)
+def test_shipped_reports_plot_time_series_only(shipped_runs, scene, tmp_path):
+    res = shipped_runs[scene]
+    text = rp.write_report(res, tmp_path / "r.html", include_plotlyjs=False).read_text()
+    shown = re.findall(r'class="report-plot" id="plot-[^"]+" data-output="([^"]+)"', text)
+    never = {"state", "section_stations", "section_stress_points", "section_forces",
+             "section_stress", "section_utilisation"}
+    never |= {n for n in res.outputs if n.startswith("geometry_")}
+    assert never <= set(res.outputs) and not never & set(shown)
+    assert set(shown) | never == set(res.outputs)
+    # the per-station arrays are in the section envelopes instead, the rest listed
+    assert text.count(f'class="{rp.STRENGTH_CLASS}"') == 2
+    for name in never:
+        assert f'<tr id="out-{name}">' in text
+
+
+@pytest.mark.parametrize("scene", REAL_SCENES)
+def test_every_plotted_component_is_named(shipped_runs, scene):
+    """Every line's name says what it is (no index fallback), no two lines of a plot share
+    a name, and the telescopic kind's components carry the names of its build."""
+    res = shipped_runs[scene]
+    n_booms = res.scene["booms"]["count"]
+    for name, fig in _figures(res):
+        shape = np.asarray(res[name]).shape[1:]
+        labels = rp.component_labels(name, shape, res.scene)
+        assert len(labels) == max(1, int(np.prod(shape))) == len(set(labels)), name
+        assert not any(re.search(r"\[\d", lab) for lab in labels), (name, labels)
+        if all(tr.type == "scatter" for tr in fig.data):
+            full = [f"{tr.meta} {tr.name}" if tr.meta else tr.name for tr in fig.data]
+            assert full == labels, name
+        else:                     # heat maps: one per group, titled by it
+            titles = [a.text for a in fig.layout.annotations]
+            assert titles == rp.component_axes(name, shape, res.scene)[0], name
+    shape = lambda n: np.asarray(res[n]).shape[1:]      # noqa: E731
+    assert rp.component_labels("tip_position", shape("tip_position")) == ["X", "Y", "Z"]
+    assert rp.component_labels("pad_forces", shape("pad_forces"))[:3] == [
+        "overlap 1-2 outer pad f_t", "overlap 1-2 outer pad f_b", "overlap 1-2 inner pad f_t"]
+    # the synchronized drive: cylinders on stages 1-2, 3-4, ..., a rope unit for booms 3, 5, ...
+    assert rp.component_labels("drive_forces", shape("drive_forces"), res.scene) == [
+        f"stage {k + 1}-{k + 2} cylinder" for k in range(0, n_booms - 1, 2)]
+    assert rp.component_labels("rope_tensions", shape("rope_tensions"), res.scene) == [
+        f"{kind} rope, boom {j + 1}" for j in range(2, n_booms, 2)
+        for kind in ("extraction", "retraction")]
+    assert rp.component_labels("friction_coefficient", shape("friction_coefficient"))[:2] == [
+        "I_12", "II_12"]
+
+
+def _page_bytes(res: Result, path: Path) -> int:
+    """The report's size without plotly.js (the same 4.6 MB in every page, or one file
+    beside a folder of reports) and without an animation."""
+    return rp.write_report(res, path, include_plotlyjs=False).stat().st_size
+
+
+@pytest.mark.parametrize("scene", REAL_SCENES)
+def test_page_size_is_bounded(shipped_runs, scene, tmp_path):
+    """Under 2 MB with the shipped 201 output times, and still with 40 times as many: the
+    lines then share the page's point budget (min/max envelopes, every peak kept)."""
+    res = shipped_runs[scene]
+    assert _page_bytes(res, tmp_path / "a.html") < 2e6
+    n = 40 * (len(res.t) - 1) + 1
+    t = np.linspace(res.t[0], res.t[-1], n)
+    long = Result(t, {k: (np.repeat(v[:1], n, axis=0) if v.shape[:1] == res.t.shape
+                          and k not in rp._STATIC else v) for k, v in res.outputs.items()},
+                  res.stats, res.scene)
+    assert _page_bytes(long, tmp_path / "b.html") < 2e6
+
+
+def test_report_with_plotly_beside_is_a_small_page(shipped_runs, tmp_path):
+    """``boom-sim report --plotly-beside`` writes plotly.js once beside the page and loads it
+    from there: the page itself stays under 2 MB, and it names the file it loads."""
+    res = shipped_runs["crane_hexagonal_4"]
+    res.save(tmp_path / "result.npz")
+    assert cli.main(["report", str(tmp_path / "result.npz"), "--plotly-beside",
+                     "--no-animation"]) == 0
+    page = tmp_path / "report.html"
+    assert (tmp_path / rp.PLOTLYJS_FILE).stat().st_size > 1e6
+    assert page.stat().st_size < 2e6
+    assert f'src="{rp.PLOTLYJS_FILE}"' in page.read_text()
+
+
+# -- boom-sim report picks up the run's animation ----------------------------------------------
+
+def _gif(path: Path) -> Path:
+    from PIL import Image
+    frames = [Image.new("RGB", (16, 12), c) for c in ((200, 0, 0), (0, 0, 200))]
+    frames[0].save(path, save_all=True, append_images=frames[1:], duration=100)
+    return path
+
+
+def test_boom_sim_report_embeds_the_animation_that_run_wrote(tmp_path, monkeypatch, capsys):
+    """run --animate writes its animation into OUT; report OUT/result.npz embeds that file
+    (unless --no-animation), as run's own report does."""
+    _fake_run(monkeypatch)
+    written = []
+    monkeypatch.setattr(sys.modules["sim_core.cli"], "_animate",
+                        lambda result, path, **kw: written.append(_gif(path)) or path)
+    out = tmp_path / "out"
+    assert cli.main(["run", "beam_through_sleeve", "--set", "solver.t_end=0.05", "--quiet",
+                     "--no-plots", "--animate", "--out", str(out)]) == 0
+    (gif,) = written
+    assert gif.parent == out
+    first = parse(out / "report.html").media_src
+    (out / "report.html").unlink()
+    capsys.readouterr()
+    assert cli.main(["report", str(out / "result.npz")]) == 0
+    assert f"(animation: {gif})" in capsys.readouterr().out
+    src = parse(out / "report.html").media_src
+    assert src == first and len(src) == 1
+    assert base64.b64decode(src[0].split(",", 1)[1]) == gif.read_bytes()
+    assert cli.main(["report", str(out / "result.npz"), "--no-animation"]) == 0
+    assert parse(out / "report.html").media_src == []
+
+
+def test_boom_sim_report_without_an_animation_beside_has_none(tmp_path, capsys):
+    result_of_every_shape().save(tmp_path / "result.npz")
+    assert cli.main(["report", str(tmp_path / "result.npz")]) == 0
+    assert "animation" not in capsys.readouterr().out
+    assert parse(tmp_path / "report.html").media_src == []
+    # an explicit --animation wins over the one beside the result
+    _gif(tmp_path / cli.ANIMATION_FILE)
+    other = _gif(tmp_path / "other.gif")
+    other.write_bytes(other.read_bytes() + b"\x00")
+    assert cli.main(["report", str(tmp_path / "result.npz"), "--animation", str(other)]) == 0
+    (src,) = parse(tmp_path / "report.html").media_src
+    assert base64.b64decode(src.split(",", 1)[1]) == other.read_bytes()

@@ -167,6 +167,38 @@ def test_contact_force_is_the_section_force_turned_to_global(exported):
         assert not np.any(mesh.cell_data["contact_force"][b][~is_cp])
 
 
+def test_pad_force_is_the_pads_transverse_reaction(exported):
+    """``pad_force`` on the contact points is the force each slider pad puts on the overlap's
+    inner boom (``pad_forces``, contact-section frame) in global components: the sum of the
+    pad's springs is the transverse reaction of its contact region, so at the outer point
+    (region II, on the inner boom) it equals the transverse part (t, b) of ``contact_force``, at
+    the inner point (region I, on the outer boom) minus it (action and reaction), to the
+    micro-motion solve's tolerance; its size is |(f_t, f_b)| of ``pad_forces``."""
+    res, pvd = exported
+    pads = res["pad_forces"]
+    for i, (_, vtu) in enumerate(_frames(pvd)):
+        mesh = meshio.read(vtu)
+        b = _block(mesh, "vertex")
+        is_cp = mesh.cell_data["part"][b] == PART_CONTACT
+        pad = mesh.cell_data["pad_force"][b][is_cp].reshape(-1, 2, 3)
+        cf = mesh.cell_data["contact_force"][b][is_cp].reshape(-1, 2, 3)
+        # the boom axis of each point's frame: the transverse part drops the e_s component
+        lines, fr, cps = (res["geometry_centre_lines"][i], res["geometry_section_frames"][i],
+                          res["geometry_contacts"][i])
+        for k in range(cps.shape[0]):
+            for j in range(2):
+                p = np.argmin(np.linalg.norm(lines[k + j] - cps[k, j], axis=-1))
+                e_s = fr[k + j, p, 2]
+                transverse = cf[k, j] - (cf[k, j] @ e_s) * e_s
+                scale = np.max(np.abs(pads[i]))
+                np.testing.assert_allclose(pad[k, j], transverse if j else -transverse,
+                                           atol=1e-6 * scale)
+        np.testing.assert_allclose(np.linalg.norm(pad, axis=-1),
+                                   np.linalg.norm(pads[i][:, ::-1], axis=-1), rtol=1e-9,
+                                   atol=1e-9 * np.max(np.abs(pads[i])))
+        assert not np.any(mesh.cell_data["pad_force"][b][~is_cp])
+
+
 def test_luffing_cylinder_payload_and_rope(swinging, tmp_path):
     """The luffing cylinder is one ``part`` 1 line D2-D3 carrying its force, the payload a
     ``part`` 4 vertex at ``payload_position`` and the hoist rope a ``part`` 2 line from the tip

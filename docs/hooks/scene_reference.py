@@ -1,8 +1,11 @@
-"""MkDocs hook: the scene reference, rendered from the declared scene fields at build time.
+"""The scene reference, generated from the declared scene fields into ``docs/scene_reference.md``.
 
-``docs/scene_reference.md`` holds the marker ``<!-- scene-reference -->``; ``on_page_markdown``
-replaces it with one section per scene kind.  Everything comes from the declarations the
-validators check with (:mod:`sim_core.scene.fields`: each kind's ``SCHEMA``, the effect
+``docs/scene_reference.md`` holds its introduction, the marker line ``<!-- scene-reference -->``
+and below it one generated section per scene kind, committed so that the file reads complete
+in a checkout.  ``python docs/hooks/scene_reference.py --write`` regenerates the part below the
+marker (written atomically); as an MkDocs hook, ``on_page_markdown`` warns (so a strict build
+fails) when the committed part differs from the generated one, and the page shows the
+generated part either way.  Everything comes from the declarations the validators check with (:mod:`sim_core.scene.fields`: each kind's ``SCHEMA``, the effect
 plug-ins' tables), nothing from the validators' source:
 
 * one table per scene table, with every key's type, unit, default, allowed range or values and
@@ -151,11 +154,51 @@ def scene_reference() -> str:
     return "\n".join(kind_section(s) for s in _schemas())
 
 
+REFERENCE = ROOT / "docs" / "scene_reference.md"
+COMMAND = "python docs/hooks/scene_reference.py --write"
+
+
+def split(text: str) -> tuple[str, str]:
+    """(the page up to and including the marker line, the generated part below it)."""
+    at = text.find(MARKER)
+    if at < 0:
+        raise ValueError(f"{REFERENCE.name} has no line {MARKER}")
+    end = at + len(MARKER)
+    return text[:end] + "\n", text[end:].lstrip("\n")
+
+
+def generated_page(text: str) -> str:
+    """The page ``text`` with its part below the marker generated anew."""
+    head, _ = split(text)
+    return f"{head}\n{scene_reference().rstrip()}\n"
+
+
+def write(path: Path = REFERENCE) -> bool:
+    """Regenerate ``path`` below its marker; True where its content changed."""
+    old = path.read_text(encoding="utf-8")
+    new = generated_page(old)
+    if new == old:
+        return False
+    from sim_core.result import atomic_path
+    with atomic_path(path) as tmp:
+        Path(tmp).write_text(new, encoding="utf-8")
+    return True
+
+
 def on_page_markdown(markdown, page, config, files, **kwargs):
-    if page.file.src_uri == "scene_reference.md" and MARKER in markdown:
-        return markdown.replace(MARKER, scene_reference())
-    return markdown
+    if page.file.src_uri != "scene_reference.md" or MARKER not in markdown:
+        return markdown
+    new = generated_page(markdown)
+    if new != markdown:
+        log.warning("docs/scene_reference.md differs from the declared scene fields: "
+                    "regenerate it with `%s`", COMMAND)
+    return new
 
 
-if __name__ == "__main__":       # preview: python docs/hooks/scene_reference.py
-    print(scene_reference())
+if __name__ == "__main__":       # python docs/hooks/scene_reference.py [--write]
+    if sys.argv[1:] == ["--write"]:
+        print(f"{REFERENCE}: {'rewritten' if write() else 'up to date'}")
+    elif sys.argv[1:]:
+        sys.exit(f"usage: {COMMAND} (without --write: print the generated part)")
+    else:
+        print(scene_reference())

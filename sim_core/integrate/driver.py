@@ -12,8 +12,15 @@ import time
 import numpy as np
 from scipy.integrate import BDF, RK45
 
+from sim_core import run_control
 from sim_core.checkpoint import object_state, restore_object_state
-from sim_core.errors import ElementEvaluationError, SimulationError, StalledIntegration
+from sim_core.errors import (
+    ElementEvaluationError,
+    RunInterrupted,
+    SimulationError,
+    StalledIntegration,
+    WallBudgetExhausted,
+)
 from sim_core.integrate import _generalized_alpha_numba as ga_numba
 from sim_core.integrate.bdf import (
     BDF_NEWTON_ITERATIONS,
@@ -108,10 +115,12 @@ class StallMonitor:
 
     * their mean step is below ``t_end / max_steps`` (a pace at which the whole run would take
       more than ``max_steps`` steps), or
-    * with a wall-clock budget ``budget`` (s): at least ``min_budget_share`` of it is spent and
-      the remaining simulated time, at the window's pace in simulated seconds per wall second,
-      would take more than ``overrun`` times the budget left -- the budget would run out
-      anyway, so the run stops now, naming the stall, instead of at the budget.
+    * with a wall-clock budget ``budget`` (s): the integration has run for at least
+      ``min_budget_share`` of it and the remaining simulated time, at the window's pace in
+      simulated seconds per wall second, would take more than ``overrun`` times the budget
+      left (the run's: ``spent`` counts the statics before the integration too) -- the
+      budget would run out anyway, so the run stops now, naming the stall, instead of at
+      the budget.
 
     Why these numbers.  ``max_steps`` = 1e6 is ~400 times the shipped scenes' step counts (the
     paper's extraction: 2477 steps for 20 s, its retraction 11311) and 10 min to hours of wall
@@ -135,13 +144,16 @@ class StallMonitor:
     overrun = 3.0
 
     def __init__(self, t_end: float, window: int | None = None, max_steps: float | None = None,
-                 budget: float | None = None, wall0: float | None = None):
+                 budget: float | None = None, wall0: float | None = None, spent=None):
         self.window = int(window or self.window)
         self.max_steps = float(max_steps or self.max_steps)
         self.t_end = float(t_end)
         self.floor = self.t_end / self.max_steps
         self.budget = budget
         self.wall0 = time.perf_counter() if wall0 is None else wall0
+        # wall seconds of the budget spent (the run's, run_control.RunBudget.elapsed: the
+        # statics before the integration count); default: since wall0
+        self.spent = spent if spent is not None else (lambda: time.perf_counter() - self.wall0)
         self.times = np.zeros(self.window)       # t after each of the last accepted steps
         self.walls = np.zeros(self.window)       # wall clock then
         self.k = 0
@@ -162,10 +174,13 @@ class StallMonitor:
             if mean < self.floor:
                 self._raise(solver, "integration stalled", mean, n,
                             f"below t_end / {self.max_steps:.0e} = {self.floor:.3g} s")
+        # the test starts once the integration itself has run for 10 % of the budget (its
+        # first steps are no guide to its pace); the budget left is the run's
         if self.budget is not None and now - self.wall0 >= self.min_budget_share * self.budget:
+            spent = self.spent()
             pace = (solver.t - t_old) / max(now - wall_old, 1e-9)   # simulated s per wall s
             need = (self.t_end - solver.t) / max(pace, 1e-300)
-            left = self.budget - (now - self.wall0)
+            left = self.budget - spent
             if 0.0 < left < need / self.overrun:       # (spent: the budget's own error)
                 self._raise(solver, "integration too slow for its wall-clock budget",
                             (solver.t - t_old) / n, n,
@@ -212,8 +227,11 @@ def integrate(model, y0: np.ndarray, t_end: float, sol: dict, progress=None, che
       number of switches, the first switch to BDF and the stiffness alarms that kept RK45.
 
     Returns (t, y, stats); raises SimulationError with the time, step and last good state on
-    failure or non-finite values, when the optional wall-clock budget ``sol["max_wall_s"]`` (s)
-    is exhausted, or on Ctrl-C (KeyboardInterrupt), and :class:`StalledIntegration` where the
+    failure or non-finite values, :class:`~sim_core.errors.WallBudgetExhausted` when the run's
+    wall-clock budget is spent (the ambient :class:`sim_core.run_control.RunBudget`: the whole
+    run's ``solver.max_wall_s``, statics included; outside a run ``sol["max_wall_s"]`` from the
+    integration's start), :class:`~sim_core.errors.RunInterrupted` on Ctrl-C (the budget's
+    interrupt flag, or KeyboardInterrupt), and :class:`StalledIntegration` where the
     steps cannot finish the run (:class:`StallMonitor`: within ``sol["stall_max_steps"]``
     steps, default 1e6, or the budget); the outputs reached so far are attached, so a
     budgeted, stalled or interrupted run still yields a partial result.  The statistics
@@ -237,7 +255,7 @@ def integrate(model, y0: np.ndarray, t_end: float, sol: dict, progress=None, che
     t_eval = np.linspace(0.0, t_end, sol["n_output"])
     rhs = _CountingRHS(model)
     kwargs = {"max_step": sol["max_step"]} if "max_step" in sol else {}
-    budget = sol.get("max_wall_s")
+    rb = run_control.for_solver(sol.get("max_wall_s"))      # the run's deadline
     wall0 = time.perf_counter()
     tol = {"rtol": sol["rtol"], "atol": sol["atol"]}
 
@@ -275,22 +293,25 @@ def integrate(model, y0: np.ndarray, t_end: float, sol: dict, progress=None, che
     switch = MethodSwitch(rhs, fresh_jacobian=fresh if probe else None, stiff_friction=band) \
         if method == "auto" else None
     njev = 0                  # Jacobians of BDF solvers already replaced by a switch
+    nlu = 0                   # and their LU factorisations of the Newton matrix
     newton_limit = bdf_newton_limit(sol.get("bdf_newton_iterations", BDF_NEWTON_ITERATIONS))
     ys = [y0]
     k_out = 1
-    stall = StallMonitor(t_end, sol.get("stall_window"), sol.get("stall_max_steps"), budget,
-                         wall0)
+    stall = StallMonitor(t_end, sol.get("stall_window"), sol.get("stall_max_steps"),
+                         rb.max_wall_s, wall0, spent=rb.elapsed)
     if saved is not None:
         ys, k_out, steps, njev = list(saved["ys"]), int(saved["k_out"]), list(saved["steps"]), \
             int(saved["njev"])
+        nlu = int(saved.get("nlu", 0))
         wall0 = time.perf_counter() - float(saved["wall_s"])
+        rb.credit(float(saved["wall_s"]))
         _restore_scipy(saved, solver, stretch.get("jac") if isinstance(solver, BDF) else None,
                        switch, stall, rhs, model, wall0)
 
     def snapshot():
-        return _scipy_snapshot(solver, stretch.get("jac") if isinstance(solver, BDF) else None,
-                               switch, stall, rhs, model, ys, k_out, steps, njev,
-                               time.perf_counter() - wall0)
+        return {**_scipy_snapshot(solver, stretch.get("jac") if isinstance(solver, BDF) else None,
+                                  switch, stall, rhs, model, ys, k_out, steps, njev,
+                                  time.perf_counter() - wall0), "nlu": nlu}
 
     def stats():
         wall = time.perf_counter() - wall0
@@ -317,6 +338,8 @@ def integrate(model, y0: np.ndarray, t_end: float, sol: dict, progress=None, che
                 out["n_jacobian_refreshes"] = rhs.n_refreshes
             else:
                 out["n_jacobians"] = njev + int(getattr(solver, "njev", 0))
+            # LU factorisations of BDF's Newton matrix (scipy's nlu, RefreshedJacobian's included)
+            out["n_lu"] = nlu + int(getattr(solver, "nlu", 0))
         if switch is not None:
             out["n_method_switches"] = len(switch.switches)
             out["n_bdf_kept"] = switch.kept_bdf     # stretch ends without a hand-back trial
@@ -352,21 +375,19 @@ def integrate(model, y0: np.ndarray, t_end: float, sol: dict, progress=None, che
                     k_out += 1
             if progress is not None:
                 progress(solver.t, time.perf_counter() - wall0)
-            if budget is not None and solver.status == "running" \
-                    and time.perf_counter() - wall0 > budget:
-                raise SimulationError(solver.t, f"wall-clock budget solver.max_wall_s = {budget:g} s "
-                                      f"exhausted (last step {solver.step_size:.3g} s)",
-                                      step=solver.step_size, last_state=solver.y)
+            if solver.status == "running":      # the run's budget and Ctrl-C
+                rb.check("integration", solver.t, solver.step_size, solver.y)
             if switch is not None and solver.status == "running":
                 old = solver
                 solver = switch.after_step(solver, make)
                 if solver is not old:
                     njev += int(getattr(old, "njev", 0))
+                    nlu += int(getattr(old, "nlu", 0))
             if checkpoint is not None and solver.status == "running" and checkpoint.due():
                 checkpoint.save("scipy", solver.t, snapshot())
     except KeyboardInterrupt:              # Ctrl-C keeps what was computed, like a budget
-        exc = SimulationError(solver.t, "interrupted by the user (KeyboardInterrupt)",
-                              step=solver.step_size, last_state=solver.y)
+        exc = RunInterrupted(solver.t, "integration", step=solver.step_size,
+                             last_state=solver.y, how="KeyboardInterrupt")
         exc.partial = (t_eval[:len(ys)], np.array(ys), stats())
         raise exc from None
     except SimulationError as exc:
@@ -470,9 +491,20 @@ def run_with_partial(integrate, collect, check=None):
             exc.result = collect(*part, str(exc))
         raise
     res = collect(ts, ys, st, None)
+    # the result's own checks evaluate it again: not where the run's budget is spent
+    late = run_control.current().exceeded("outputs", float(res.t[-1]) if len(res.t) else 0.0)
+    if late is not None:
+        res.error = str(late)
+        late.result = res
+        raise late
     checks = result_checks(res)
     if check is not None:
-        checks.update(check(res))
+        try:
+            checks.update(check(res))
+        except (WallBudgetExhausted, RunInterrupted) as exc:   # the checks' loops check it
+            res.error = str(exc)
+            exc.result = res
+            raise
     return check_result(res, checks)
 
 
@@ -533,7 +565,7 @@ def _alpha_fixed(model, y0: np.ndarray, t_end: float, sol: dict, progress=None,
     t_eval = np.linspace(0.0, t_end, sol["n_output"])
     h, rho = float(sol["h"]), float(sol.get("rho_inf", 0.9))
     newton_atol = float(sol.get("newton_atol", 1e-8))
-    budget = sol.get("max_wall_s")
+    rb = run_control.for_solver(sol.get("max_wall_s"))      # the run's deadline
     wall0 = time.perf_counter()
     p = GeneralizedAlphaParameters.from_rho_inf(rho)
     plan = model.element_loop_plan() if isinstance(model, Model) else None
@@ -561,6 +593,7 @@ def _alpha_fixed(model, y0: np.ndarray, t_end: float, sol: dict, progress=None,
         saved = checkpoint.take("alpha_numpy_fixed") if checkpoint is not None else None
         if saved is not None:
             wall0 = time.perf_counter() - float(saved["wall_s"])
+            rb.credit(float(saved["wall_s"]))
 
         def hook(get):
             if checkpoint.due():
@@ -568,10 +601,9 @@ def _alpha_fixed(model, y0: np.ndarray, t_end: float, sol: dict, progress=None,
                 checkpoint.save("alpha_numpy_fixed", float(st["ga"]["t"]), {
                     "ga": st, "warm": warm_starts(model), "wall_s": time.perf_counter() - wall0})
 
-        def each_step(t, hh, q, v):        # the wall budget after every step
-            if budget is not None and t < t_end and time.perf_counter() - wall0 > budget:
-                raise SimulationError(t, f"wall-clock budget solver.max_wall_s = {budget:g} s "
-                                      "exhausted", step=hh, last_state=np.concatenate([q, v]))
+        def each_step(t, hh, q, v):        # the run's budget and Ctrl-C after every step
+            if t < t_end:
+                rb.check("integration", t, hh, np.concatenate([q, v]))
 
         try:
             r = integrate_generalized_alpha(
@@ -608,6 +640,7 @@ def _alpha_fixed(model, y0: np.ndarray, t_end: float, sol: dict, progress=None,
         counts[:] = saved["counts"]
         ys, h_used, k0 = list(saved["ys"]), list(saved["h_used"]), int(saved["k"])
         wall0 = time.perf_counter() - float(saved["wall_s"])
+        rb.credit(float(saved["wall_s"]))
     chunk = 1                  # steps per compiled call, grown to ~0.05 s of wall time
     for k in range(k0, len(t_eval)):
         span = t_eval[k] - t_eval[k - 1]
@@ -636,17 +669,20 @@ def _alpha_fixed(model, y0: np.ndarray, t_end: float, sol: dict, progress=None,
                            "finite); reduce solver.h", hh)
             i += c
             chunk = max(1, min(10 ** 6, int(0.05 * c / max(time.perf_counter() - tic, 1e-9))))
-            if budget is not None and i < m and time.perf_counter() - wall0 > budget:
-                exc = fail(float(t_eval[k - 1] + i * hh), "wall-clock budget solver.max_wall_s "
-                           f"= {budget:g} s exhausted", hh)
-                exc.last_state = np.concatenate([q, v])
-                raise exc
+            if i < m:
+                exc = rb.exceeded("integration", float(t_eval[k - 1] + i * hh), hh,
+                                  np.concatenate([q, v]))
+                if exc is not None:
+                    exc.partial = (t_eval[:len(ys)], np.array(ys), stats())
+                    raise exc
         ys.append(np.concatenate([q, v]))
         if progress is not None:
             progress(float(t_eval[k]), time.perf_counter() - wall0)
-        if budget is not None and time.perf_counter() - wall0 > budget and k < len(t_eval) - 1:
-            raise fail(float(t_eval[k]), f"wall-clock budget solver.max_wall_s = {budget:g} s "
-                       "exhausted", hh)
+        if k < len(t_eval) - 1:
+            exc = rb.exceeded("integration", float(t_eval[k]), hh, ys[-1])
+            if exc is not None:
+                exc.partial = (t_eval[:len(ys)], np.array(ys), stats())
+                raise exc
         if checkpoint is not None and k < len(t_eval) - 1 and checkpoint.due():
             checkpoint.save("alpha_fixed", float(t_eval[k]), {
                 "q": q, "v": v, "qdd": qdd, "a": a, "Sinv": Sinv, "qdd_prev": qdd_prev,
@@ -662,7 +698,7 @@ def integrate_ros2(model, y0: np.ndarray, t_end: float, sol: dict, progress=None
     ``sol["jacobian_interval"]`` s; the wall budget and checkpoints after whole output
     intervals (a resumed run takes the same steps with the same Jacobian)."""
     t_eval = np.linspace(0.0, t_end, sol["n_output"])
-    budget = sol.get("max_wall_s")
+    rb = run_control.for_solver(sol.get("max_wall_s"))      # the run's deadline
     wall0 = time.perf_counter()
     ros = RosenbrockW2(model, float(sol["h"]), float(sol["jacobian_interval"]))
     ys, k0 = [np.array(y0, dtype=float)], 1
@@ -672,6 +708,7 @@ def integrate_ros2(model, y0: np.ndarray, t_end: float, sol: dict, progress=None
         ros.restore(saved["ros2"])
         restore_warm_starts(model, saved["warm"])
         wall0 = time.perf_counter() - float(saved["wall_s"])
+        rb.credit(float(saved["wall_s"]))
 
     def stats():
         wall = time.perf_counter() - wall0
@@ -690,15 +727,14 @@ def integrate_ros2(model, y0: np.ndarray, t_end: float, sol: dict, progress=None
         except SimulationError as exc:
             raise fail(exc) from None
         except KeyboardInterrupt:
-            raise fail(SimulationError(float(t_eval[k - 1]), "interrupted by the user "
-                                       "(KeyboardInterrupt)", step=ros.h,
-                                       last_state=ys[-1])) from None
+            raise fail(RunInterrupted(float(t_eval[k - 1]), "integration", step=ros.h,
+                                      last_state=ys[-1], how="KeyboardInterrupt")) from None
         if progress is not None:
             progress(float(t_eval[k]), time.perf_counter() - wall0)
-        if budget is not None and time.perf_counter() - wall0 > budget and k < len(t_eval) - 1:
-            raise fail(SimulationError(float(t_eval[k]), "wall-clock budget solver.max_wall_s "
-                                       f"= {budget:g} s exhausted", step=ros.h,
-                                       last_state=ys[-1]))
+        if k < len(t_eval) - 1:                # the run's budget and Ctrl-C
+            exc = rb.exceeded("integration", float(t_eval[k]), ros.h, ys[-1])
+            if exc is not None:
+                raise fail(exc)
         if checkpoint is not None and k < len(t_eval) - 1 and checkpoint.due():
             checkpoint.save("ros2", float(t_eval[k]), {
                 "ys": np.array(ys), "k": k + 1, "ros2": ros.state(), "warm": warm_starts(model),
@@ -777,7 +813,7 @@ def _alpha_adaptive(model, y0: np.ndarray, t_end: float, sol: dict, progress=Non
     newton_atol = float(sol.get("newton_atol", 0.1 * atol))
     h_max = min(float(sol.get("h_max", t_end)), t_end)
     h_min = ALPHA_FLOOR * t_end
-    budget = sol.get("max_wall_s")
+    rb = run_control.for_solver(sol.get("max_wall_s"))      # the run's deadline
     window = int(sol.get("stall_window") or StallMonitor.window)
     pace = _StepPace(t_end, window, sol.get("stall_max_steps") or StallMonitor.max_steps)
     wall0 = time.perf_counter()
@@ -813,14 +849,16 @@ def _alpha_adaptive(model, y0: np.ndarray, t_end: float, sol: dict, progress=Non
         exc.partial = (t_eval[:k_out], Y[:k_out].copy(), stats())
         return exc
 
-    def check_budget():
-        if budget is not None and time.perf_counter() - wall0 > budget and hs[0] < t_end:
-            raise fail(f"wall-clock budget solver.max_wall_s = {budget:g} s exhausted (last "
-                       f"step {hs[2]:.3g} s)", float(hs[2]))
+    def check_budget():                    # the run's budget and Ctrl-C
+        if hs[0] < t_end:
+            exc = rb.exceeded("integration", float(hs[0]), float(hs[2]), state["y"])
+            if exc is not None:
+                exc.partial = (t_eval[:k_out], Y[:k_out].copy(), stats())
+                raise exc
 
     if plan is None:
         return _alpha_adaptive_numpy(model, y0, t_end, sol, progress, t_eval, p, rtol, atol,
-                                     h_max, h_min, budget, window, wall0, checkpoint)
+                                     h_max, h_min, rb, window, wall0, checkpoint)
 
     q, v = np.array(y0[:n], dtype=float), np.array(y0[n:], dtype=float)
     qdd, a = _initial_accelerations(plan, q, v)
@@ -840,6 +878,7 @@ def _alpha_adaptive(model, y0: np.ndarray, t_end: float, sol: dict, progress=Non
         state["y"] = np.concatenate([q, v])
         pace.marks, pace.slowest = [tuple(m) for m in saved["pace_marks"]], saved["pace_slowest"]
         wall0 = time.perf_counter() - float(saved["wall_s"])
+        rb.credit(float(saved["wall_s"]))
     try:
         while True:
             try:
@@ -878,7 +917,8 @@ def _alpha_adaptive(model, y0: np.ndarray, t_end: float, sol: dict, progress=Non
         exc.partial = (t_eval[:k_out], Y[:k_out].copy(), stats())
         raise
     except KeyboardInterrupt:              # Ctrl-C keeps what was computed, like a budget
-        raise fail("interrupted by the user (KeyboardInterrupt)", float(hs[2])) from None
+        raise fail("integration", float(hs[2]), RunInterrupted,
+                   how="KeyboardInterrupt") from None
     return t_eval, Y, stats()
 
 
@@ -886,14 +926,17 @@ def _alpha_adaptive_numpy(model, y0, t_end, sol, progress, t_eval, p, rtol, atol
                           h_min, budget, window, wall0, checkpoint=None):
     """The numpy path of :func:`_alpha_adaptive`: :func:`integrate_generalized_alpha` with the
     structured tangent, the position estimate and the same floor; the stall monitor, the
-    budget, the progress callback and the checkpoints after every accepted step."""
+    run's budget (``budget``: a :class:`sim_core.run_control.RunBudget`), the progress
+    callback and the checkpoints after every accepted step."""
     n = model.n_dof
-    stall = StallMonitor(t_end, window, sol.get("stall_max_steps"), budget, wall0)
+    stall = StallMonitor(t_end, window, sol.get("stall_max_steps"), budget.max_wall_s, wall0,
+                         spent=budget.elapsed)
     shim = type("Step", (), {})()
     shim.t = shim.t_old = 0.0
     saved = checkpoint.take("alpha_numpy_adaptive") if checkpoint is not None else None
     if saved is not None:
         wall0 = time.perf_counter() - float(saved["wall_s"])
+        budget.credit(float(saved["wall_s"]))
         _restore_stall(stall, saved["stall"], wall0)
         shim.t, shim.t_old = saved["shim"]
         shim.y = np.array(saved["shim_y"], dtype=float)
@@ -910,10 +953,7 @@ def _alpha_adaptive_numpy(model, y0, t_end, sol, progress, t_eval, p, rtol, atol
         shim.t_old, shim.t, shim.y = shim.t, t, np.concatenate([q, v])
         if t < t_end:
             stall.update(shim)
-            if budget is not None and time.perf_counter() - wall0 > budget:
-                raise SimulationError(t, f"wall-clock budget solver.max_wall_s = {budget:g} s "
-                                      f"exhausted (last step {h:.3g} s)", step=h,
-                                      last_state=shim.y)
+            budget.check("integration", t, h, shim.y)
         if progress is not None:
             progress(t, time.perf_counter() - wall0)
 
@@ -949,8 +989,8 @@ def _alpha_adaptive_numpy(model, y0, t_end, sol, progress, t_eval, p, rtol, atol
         ts, q, v, _ = getattr(exc, "partial_output", (t_eval[:1], y0[None, :n], y0[None, n:], None))
         st = getattr(exc, "partial_stats", None)
         if isinstance(exc, KeyboardInterrupt):  # Ctrl-C keeps what was computed, like a budget
-            err = SimulationError(shim.t, "interrupted by the user (KeyboardInterrupt)",
-                                  last_state=getattr(shim, "y", y0))
+            err = RunInterrupted(shim.t, "integration", last_state=getattr(shim, "y", y0),
+                                 how="KeyboardInterrupt")
         else:
             err = exc
         err.partial = (np.asarray(ts), np.hstack([q, v]),

@@ -394,8 +394,8 @@ def kkt_factor_pipelined(Mr, Fr, C, blocks, worker, red, sg, IDX, block_of,
     failed = np.zeros(1, dtype=np.int64)
     e, E = 0, IDX.shape[0]
     while e < E:
-        e = _scatter_factor(worker.ctl, e, 1 << 16, Mr, Fr, red, sg, IDX, worker.Ms, worker.Fs,
-                            block_of, C, B, lens, r, facs, As, Bs, Ws, S, failed)
+        e = _scatter_factor(worker.ctl, e, worker.wait_spins, Mr, Fr, red, sg, IDX, worker.Ms,
+                            worker.Fs, block_of, C, B, lens, r, facs, As, Bs, Ws, S, failed)
         if e < E:
             worker.wait_element(e)          # checks the worker; raises where it failed
     out = worker.result()                   # the request is complete: collect it

@@ -3,6 +3,10 @@
 Static equilibrium solves the reduced force balance P^T F(t, Q(z), 0) = 0 by Newton's method
 with a finite-difference tangent (the models here have at most a few hundred coordinates).
 Linearized modes solve K phi = omega^2 M phi with K = -dF_r/dz at the equilibrium.
+
+The solvers check the run's wall-clock budget and interrupt flag
+(:func:`sim_core.run_control.check`, phase ``statics``) before every Newton iteration and
+every corrector iteration of the load continuation.
 """
 
 from __future__ import annotations
@@ -13,6 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.linalg as sla
 
+from sim_core import run_control
 from sim_core.errors import NoStaticEquilibrium, SimulationError
 from sim_core.model.model import Model
 
@@ -49,6 +54,7 @@ def static_equilibrium(model: Model, z0: np.ndarray, t: float = 0.0, tol: float 
     for _ in range(max_iter):
         if np.linalg.norm(r) <= tol * scale:
             return z
+        run_control.check("statics", t)
         dz = np.linalg.solve(tangent_stiffness(model, t, z), r)
         z = z + dz
         r = reduced_static_force(model, t, z)
@@ -161,6 +167,7 @@ def constrained_static_equilibrium(model: Model, z0: np.ndarray, t: float = 0.0,
         r1 = Fr + C.T @ lam
         if np.linalg.norm(r1) <= tol * scale and np.max(np.abs(phi), initial=0.0) < 1e-10:
             return z, lam
+        run_control.check("statics", t)
         K = structured_force_tangent(model, t, z, lam)
         m = C.shape[0]
         A = np.block([[K, C.T], [C, np.zeros((m, m))]])
@@ -310,6 +317,7 @@ def load_continuation(model: Model, z0: np.ndarray, t: float = 0.0, tol: float =
         return B
 
     for _ in range(max_steps):
+        run_control.check("statics", t)
         # ---- unit tangent at the converged point (z, mu, lg); K: force tangent there
         F0, phi, C = at(0.0, z)
         Fl = at(1.0, z)[0] - F0
@@ -361,6 +369,7 @@ def load_continuation(model: Model, z0: np.ndarray, t: float = 0.0, tol: float =
                     ok = True
                     break
                 r_prev = rn
+                run_control.check("statics", t)
                 with gravity_scaled(model, li):          # full Newton: tangent at the iterate
                     Ki = structured_force_tangent(model, t, zi, mui)
                 Fli = at(1.0, zi)[0] - at(0.0, zi)[0]     # dR/dlam_g at the iterate

@@ -33,6 +33,14 @@ word hands them over (acquire/release atomics; compare-and-swap where both threa
 * The caller waits for DONE spinning in compiled code too (without the GIL), checking that
   the worker thread is alive and yielding its core (``sched_yield``) between rounds of
   ~0.5 ms, so that a worker that shares its core gets on.
+* Forced on (``SIM_CORE_ELEMENT_WORKER=on``) in a process with fewer than two cores in its
+  affinity set, the two threads share one core and neither spins
+  (:meth:`ElementWorker.share_core`): the idle worker yields its core (``sched_yield``) for
+  ``SPIN_S`` after each request, then polls, and the caller yields after every check.  A
+  spinning thread there holds the core until the scheduler preempts it (milliseconds per
+  hand-over: a short RK45 run of a beam took 4-7 times as long as on the calling thread);
+  yielding hands it over at once.  The batch and its order are the same, so the numbers are
+  bit-identical.
 
 A forked child gets its own worker (the parent's thread does not exist there: the process id
 is checked at every post).
@@ -95,8 +103,10 @@ IDLE, REQUEST, DONE, EXITED, ERROR, STOP = 0, 1, 2, 3, 4, 5
 PROGRESS = 4            # ctl word: elements of the current request written so far
 T_POST, T_START, T_END = 5, 6, 7    # ctl words: CLOCK_MONOTONIC ns of the post, start, end
 _CLOCK_CALLER, _CLOCK_WORKER = 8, 10    # ctl words 8-9, 10-11: each thread's struct timespec
-CTL_WORDS = 12
+YIELD_NS = 12           # ctl word: ns after a request's end that a core-sharing worker yields
+CTL_WORDS = 13
 SPIN_S = 5e-3           # seconds of spinning after a request before sleeping
+WAIT_SPINS = 1 << 16    # the caller's spinning rounds between yields (~0.5 ms), own core
 SLEEP_US = 200          # microseconds per sleeping poll
 POLLS = 5000            # sleeping polls before the worker exits (~1 s idle)
 
@@ -162,6 +172,9 @@ if cardan_compiled.AVAILABLE and element_compiled.AVAILABLE:
                         ctypes.cast(_libc.clock_gettime, ctypes.c_void_p).value)
         _clock_gettime = _types.ExternalFunction("sim_core_worker_clock_gettime",
                                                  _types.int32(_types.int32, _types.voidptr))
+        _llb.add_symbol("sim_core_worker_sched_yield",
+                        ctypes.cast(_libc.sched_yield, ctypes.c_void_p).value)
+        _sched_yield = _types.ExternalFunction("sim_core_worker_sched_yield", _types.int32())
         _MONOTONIC = time.CLOCK_MONOTONIC
         if ctypes.sizeof(ctypes.c_long) != 8:       # struct timespec as two int64 words
             raise OSError("struct timespec is not two 64-bit words here")
@@ -180,10 +193,13 @@ def _loop(ctl, QE, QDE, Ms, Fs, par, n, t0, t1, t2, t3, t4, t5, t6, t7, bases, i
           Jrots, Ds, inertia, elasticity, cstep, no_acc):
     """The worker: serve REQUEST -> DONE (stamping its start and end, ctl[T_START], ctl[T_END])
     until told to STOP (-> EXITED) or idle for ctl[1] spins + ctl[2] polls of ctl[3] us, then
-    IDLE -> EXITED and return.  par = (h, g_x, g_y, g_z)."""
+    IDLE -> EXITED and return.  With ctl[YIELD_NS] > 0 (a core shared with the caller) it
+    yields its core (``sched_yield``) instead of spinning, for ctl[YIELD_NS] ns after each
+    request's end, then polls.  par = (h, g_x, g_y, g_z)."""
     idle = 0
     spin = ctl[1]
     polls = ctl[2]
+    yield_ns = ctl[YIELD_NS]
     while True:
         s = _load_acquire(ctl, 0)
         if s == STOP:
@@ -204,6 +220,8 @@ def _loop(ctl, QE, QDE, Ms, Fs, par, n, t0, t1, t2, t3, t4, t5, t6, t7, bases, i
             ctl[T_END] = _now_ns(ctl, _CLOCK_WORKER)
             _store_release(ctl, 0, DONE)
             idle = 0
+        elif yield_ns > 0 and _now_ns(ctl, _CLOCK_WORKER) - ctl[T_END] < yield_ns:
+            _sched_yield()
         elif idle < spin:
             idle += 1
             _cpu_pause()
@@ -321,6 +339,9 @@ class ElementWorker:
         self.ctl = np.zeros(CTL_WORDS, dtype=np.int64)
         self.ctl[0] = EXITED
         self.ctl[1:4] = spin_iterations(SPIN_S) if spin is None else spin, polls, sleep_us
+        self._spin = int(self.ctl[1])
+        self.shared_core = False          # the worker shares the caller's core (share_core)
+        self.wait_spins = WAIT_SPINS      # the caller's spinning rounds between yields
         self.QE = np.zeros((E, nq))
         self.QDE = np.zeros((E, nq))
         self.Ms = np.zeros((E, nq, nq))
@@ -401,11 +422,30 @@ class ElementWorker:
             self.thread.join()
         self._settle()
 
+    def share_core(self, shared: bool) -> None:
+        """Wait without spinning where the worker shares one core with the caller (a process
+        restricted to one processor with the worker forced on): there a spinning thread only
+        holds the core the other one needs until the scheduler preempts it (milliseconds per
+        hand-over).  Shared: the idle worker yields its core (``sched_yield``) for ``SPIN_S``
+        after each request, then polls; the caller checks once between yields.  Only the
+        waiting changes: the same compiled batch computes the same numbers in the same order.
+        A running worker thread is stopped first (it reads its waiting settings when it
+        starts)."""
+        shared = bool(shared)
+        if shared == self.shared_core:
+            return
+        self.stop()
+        self.shared_core = shared
+        self.ctl[1] = 0 if shared else self._spin
+        self.ctl[YIELD_NS] = int(SPIN_S * 1e9) if shared else 0
+        self.wait_spins = 1 if shared else WAIT_SPINS
+
     def wait_element(self, e: int) -> None:
         """Wait until element e of the posted request is written (Ms[e], Fs[e]; the rest of
         the request may still run: :meth:`result` collects it).  Between spinning rounds
-        (~0.5 ms) the calling thread yields its core (a worker that shares it gets on)."""
-        while not _wait_progress(self.ctl, e, 1 << 16):
+        (``wait_spins``: ~0.5 ms, one round on a shared core) the calling thread yields its
+        core (a worker that shares it gets on)."""
+        while not _wait_progress(self.ctl, e, self.wait_spins):
             self._check(_get(self.ctl))
             os.sched_yield()
 
@@ -413,7 +453,7 @@ class ElementWorker:
         """Wait for the posted request: (Ms, Fs), the mailbox's arrays (yielding the core
         between spinning rounds, as :meth:`wait_element`)."""
         while True:
-            s = _wait(self.ctl, 1 << 16)
+            s = _wait(self.ctl, self.wait_spins)
             if s == DONE:             # the worker writes the mailbox only on a REQUEST,
                 c = self.ctl
                 self.timing = (int(c[T_POST]), int(c[T_START]), int(c[T_END]), self.fresh)
@@ -534,7 +574,8 @@ class Governor:
     (``use_worker``) or runs on the calling thread, from what the worker's requests took.
 
     ``allowed``: a thread may be used at all (mode "on", or "auto" with at least two cores in
-    the affinity set).  ``forced``: mode "on" (no measurement, the worker always).  Creating
+    the affinity set).  ``forced``: mode "on" (no measurement, the worker always; with fewer
+    than two cores it waits without spinning, :meth:`ElementWorker.share_core`).  Creating
     one also sets the process's OpenBLAS thread count to the one asked for (one unless the
     user set another: :func:`limit_blas_threads`).
 
@@ -610,6 +651,8 @@ class Governor:
         if not self.allowed:
             return False
         if self.forced:
+            if worker.shared_core != (self.cores < 2):
+                worker.share_core(self.cores < 2)
             return True
         if self.using:
             self._observe(worker)

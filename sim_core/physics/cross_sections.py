@@ -94,7 +94,7 @@ import numpy as np
 from sim_core.errors import SceneError
 from sim_core.physics.sections import annular_sector_moments
 
-__all__ = ["METHODS", "SHAPES", "CrossSection", "clearance", "cross_section"]
+__all__ = ["METHODS", "SHAPES", "CrossSection", "analysed_section", "clearance", "cross_section"]
 
 #: Section shapes accepted by :func:`cross_section`.
 SHAPES = ("u", "box", "polygon", "properties")
@@ -163,6 +163,9 @@ class CrossSection:
     patches: tuple
     mass_per_length: float | None
     method: str
+    #: the normalised spec (shape, items) the section was made from (None: built directly);
+    #: :mod:`sim_core.physics.section_stress` meshes the same walls from it
+    key: tuple | None = None
 
 
 # ----------------------------------------------------------------------------- input checks
@@ -591,11 +594,8 @@ def _fe(outer: np.ndarray, inner: np.ndarray, t: float) -> dict:
     """The finite-element constants of the wall between ``outer`` and ``inner``, from the disk
     cache where an analysis of the same polygons, mesh rule and sectionproperties version is
     there (a deterministic computation: the same inputs give the same numbers), else computed
-    and stored (written atomically; an unwritable cache is skipped)."""
+    and stored (:func:`disk_cached`)."""
     import hashlib
-    import json
-    import os
-    import tempfile
     from importlib.metadata import version
 
     h = hashlib.sha256()
@@ -603,16 +603,28 @@ def _fe(outer: np.ndarray, inner: np.ndarray, t: float) -> dict:
         h.update(np.ascontiguousarray(a, dtype=float).tobytes())
     h.update(repr((float(t), MESH_SIZE_PER_WALL, _CACHE_FORMAT,
                    version("sectionproperties"))).encode())
+    vals = disk_cached(h.hexdigest(), _FE_KEYS, lambda: _fe_compute(outer, inner, t))
+    return {k: float(v) for k, v in vals.items()}
+
+
+def disk_cached(name: str, keys: set, compute) -> dict:
+    """The JSON object ``name`` of the disk cache (:func:`_cache_dir`) where it is there and has
+    exactly the ``keys``, else ``compute()`` (a JSON-serialisable dict), stored atomically
+    (temporary file and rename; an unwritable cache is skipped)."""
+    import json
+    import os
+    import tempfile
+
     folder = _cache_dir()
-    path = None if folder is None else folder / f"{h.hexdigest()}.json"
+    path = None if folder is None else folder / f"{name}.json"
     if path is not None and path.is_file():
         try:
             vals = json.loads(path.read_text())
-            if set(vals) == _FE_KEYS:
-                return {k: float(v) for k, v in vals.items()}
+            if set(vals) == set(keys):
+                return vals
         except (OSError, ValueError):
             pass
-    vals = _fe_compute(outer, inner, t)
+    vals = compute()
     if path is not None:
         try:
             folder.mkdir(parents=True, exist_ok=True)
@@ -630,7 +642,9 @@ _CACHE_FORMAT = 1
 _FE_KEYS = {"A", "y_c", "z_c", "I_t", "I_b", "I_tb", "J", "y_s", "z_s"}
 
 
-def _fe_compute(outer: np.ndarray, inner: np.ndarray, t: float) -> dict:
+def _sp_section(outer: np.ndarray, inner: np.ndarray, t: float):
+    """The sectionproperties Section of the wall between ``outer`` and ``inner`` (mesh rule of
+    the module docstring), its geometric and warping analyses done."""
     try:
         from sectionproperties.analysis.section import Section
         from sectionproperties.pre.geometry import Geometry
@@ -645,6 +659,24 @@ def _fe_compute(outer: np.ndarray, inner: np.ndarray, t: float) -> dict:
     sec = Section(geom)
     sec.calculate_geometric_properties()
     sec.calculate_warping_properties()
+    return sec
+
+
+def analysed_section(cs: CrossSection):
+    """The finite-element section (sectionproperties ``Section``, geometric and warping
+    analyses done) of ``cs``: the walls and mesh of the "sectionproperties" method, whatever
+    method gave ``cs`` (for the stress recovery of :mod:`sim_core.physics.section_stress`).
+    Raises SceneError for a section without geometry ("properties")."""
+    if cs.key is None or cs.key[0] == "properties":
+        raise SceneError(f"section of shape {cs.shape!r}: a stress analysis needs the wall "
+                         "geometry (allowed shapes: 'u', 'box', 'polygon')")
+    shape, items = cs.key
+    p = dict(items)
+    return _sp_section(*_mesh_walls(shape, p, _closed_form(shape, p)["exact"]), p["wall"])
+
+
+def _fe_compute(outer: np.ndarray, inner: np.ndarray, t: float) -> dict:
+    sec = _sp_section(outer, inner, t)
     ixx_c, iyy_c, ixy_c = sec.get_ic()   # sectionproperties x = our y, its y = our z
     y_c, z_c = sec.get_c()
     y_s, z_s = sec.get_sc()
@@ -661,7 +693,7 @@ def _cached(key: tuple, method: str) -> CrossSection:
         return CrossSection(shape=shape, A=p["A"], I_t=p["I_t"], I_b=p["I_b"], I_tb=p["I_tb"],
                             J=p["J"], y_c=p["y_c"], z_c=p["z_c"], y_s=math.nan, z_s=math.nan,
                             outer=None, inner=None, patches=(),
-                            mass_per_length=p["mass_per_length"], method="given")
+                            mass_per_length=p["mass_per_length"], method="given", key=key)
     cf = _closed_form(shape, p)
     outer, inner = _walls(shape, p)
     patches = tuple(tuple(float(x) if i >= 2 else x for i, x in enumerate(pa))
@@ -673,7 +705,7 @@ def _cached(key: tuple, method: str) -> CrossSection:
     else:
         vals = _fe(*_mesh_walls(shape, p, cf["exact"]), p["wall"])
     return CrossSection(shape=shape, outer=_readonly(outer), inner=_readonly(inner),
-                        patches=patches, mass_per_length=None, method=method, **vals)
+                        patches=patches, mass_per_length=None, method=method, key=key, **vals)
 
 
 def cross_section(spec: dict, method: str = "sectionproperties") -> CrossSection:

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import sys
 from dataclasses import dataclass, field as _dc_field
 from typing import Any
 
@@ -55,6 +56,9 @@ def _with_unit(rng: str, unit: str) -> str:
     return f"{rng} {unit}" if unit else rng
 
 
+_FLOAT_MAX = sys.float_info.max
+
+
 def number(table: dict, key: str, where: str, default=None, *, lo=None, hi=None,
            lo_open=False, hi_open=False, integer=False, unit: str = "") -> float:
     """A finite number in [lo, hi] (open ends if requested); errors name the field, the value
@@ -68,15 +72,18 @@ def number(table: dict, key: str, where: str, default=None, *, lo=None, hi=None,
         return default
     v = table[key]
     if isinstance(v, bool) or not isinstance(v, (int, float)):
-        raise SceneError(f"{field} = {v!r}: must be {kind} in {rng}")
+        raise SceneError(f"{field} = {short_repr(v)}: must be {kind} in {rng}")
+    if isinstance(v, int) and abs(v) > _FLOAT_MAX:     # float(v) would overflow
+        raise SceneError(f"{field} = {short_repr(v)}: out of range (beyond a float's "
+                         f"{_FLOAT_MAX:.4g}), allowed {rng}")
     if not math.isfinite(v):
         raise SceneError(f"{field} = {v!r}: must be finite (NaN/inf not allowed), allowed {rng}")
     if integer and int(v) != v:
         raise SceneError(f"{field} = {v!r}: must be an integer in {rng}")
     if lo is not None and (v < lo or (lo_open and v == lo)):
-        raise SceneError(f"{field} = {v!r}: out of range, allowed {rng}")
+        raise SceneError(f"{field} = {short_repr(v)}: out of range, allowed {rng}")
     if hi is not None and (v > hi or (hi_open and v == hi)):
-        raise SceneError(f"{field} = {v!r}: out of range, allowed {rng}")
+        raise SceneError(f"{field} = {short_repr(v)}: out of range, allowed {rng}")
     return int(v) if integer else float(v)
 
 
@@ -136,8 +143,13 @@ def choice(table: dict, key: str, where: str, allowed: tuple[str, ...], default=
 
 
 def short_repr(v, n: int = 80) -> str:
-    """repr of a value, cut to n characters (a huge array in an error message)."""
-    r = repr(v)
+    """repr of a value, cut to n characters (a huge array or integer in an error message)."""
+    try:
+        r = repr(v)
+    except ValueError:          # an integer past Python's digit limit for str(), or inside v
+        return (f"<an integer of {v.bit_length()} bits>" if isinstance(v, int) else
+                f"<a {type(v).__name__} holding an integer of over "
+                f"{getattr(sys, 'get_int_max_str_digits', int)()} digits>")
     return r if len(r) <= n else r[:n - 5] + " ...]"
 
 

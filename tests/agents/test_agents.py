@@ -109,7 +109,7 @@ def test_ppo_smoke_train_and_evaluate(tmp_path):
     from agents.train_ppo import train
     path = train(512, seed=1, out=tmp_path / "run", n_envs=1, vec="dummy",
                  checkpoint_every=0, progress=False, curve_every=100)
-    assert path.exists() and (tmp_path / "run" / "model_vecnormalize.pkl").exists()
+    assert path.exists() and (tmp_path / "run" / "model_vecnormalize.json").exists()
     curve = (tmp_path / "run" / "learning_curve.csv").read_text().splitlines()
     assert curve[0].startswith("env_steps") and len(curve) >= 2
     fig = tmp_path / "ev.png"

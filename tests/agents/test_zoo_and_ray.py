@@ -54,7 +54,7 @@ def test_train_uses_the_given_file(tmp_path):
     model = PPO.load(model_path, device="cpu")
     assert model.n_steps == 192 and model.batch_size == 48 and model.n_epochs == 1
     assert model.policy.net_arch == [16]
-    assert not (tmp_path / "run" / "model_vecnormalize.pkl").exists()     # normalize: false
+    assert not (tmp_path / "run" / "model_vecnormalize.json").exists()     # normalize: false
     path.write_text(yaml.safe_dump({ENV_ID: dict(entry, frame_stack=4)}))
     with pytest.raises(ValueError, match="frame_stack"):
         train_ppo.train(64, seed=0, out=tmp_path / "bad", n_envs=1, vec="dummy", hyperparams=path)
@@ -142,7 +142,7 @@ def test_train_seeds_writes_run_folders_and_report(tmp_path):
                            "--out", str(out)]) == 0
     for s in (3, 4):
         d = out / f"seed{s}"
-        for f in ("model.zip", "model_vecnormalize.pkl", "model_meta.json", "learning_curve.csv"):
+        for f in ("model.zip", "model_vecnormalize.json", "model_meta.json", "learning_curve.csv"):
             assert (d / f).exists(), d / f
         assert json.loads((d / "model_meta.json").read_text())["seed"] == s
     md = (out / "comparison.md").read_text()

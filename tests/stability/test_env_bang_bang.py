@@ -6,6 +6,8 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
+from sim_core.errors import CommandError
+
 import boom_env  # noqa: F401  (registers the environments)
 
 from .thresholds import ENV_MAX_DEFLECTION
@@ -64,7 +66,10 @@ def test_env_reports_divergence_of_the_solver_instead_of_nan():
         env.step(np.ones(1, np.float32))
     sim = env.unwrapped.plant.sim                           # the modal plant's Simulation
     state = sim.save_state()
-    sim.restore_state({**state, "qd": np.asarray(state["qd"]) * np.nan})
+    with pytest.raises(CommandError):                       # a snapshot must be finite ...
+        sim.restore_state({**state, "qd": np.asarray(state["qd"]) * np.nan})
+    rom = sim._impl.rom                                     # ... so poison the ROM itself
+    rom.qd = np.asarray(rom.qd) * np.nan
     obs, r, term, trunc, info = env.step(-np.ones(1, np.float32))
     assert trunc and not term and info["diverged"] and info["reason"]
     assert np.all(np.isfinite(obs)) and np.isfinite(r)

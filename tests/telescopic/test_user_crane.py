@@ -67,6 +67,7 @@ def test_two_section_tip_deflection_matches_stepped_beam():
                        "base": [L_h, -2.0], "head_on_boom": [L_h, 0.0]},
            "drive": {"v_max": 0.1, "t_ramp": 1.0, "t_hold_end": 2.0},
            "effects": {"friction": False, "contact_distribution": False, "filtering": False},
+           "contact": {"moment_model": "rigid"},     # the rigid contact sections of Section 6
            "payload": {"mass": 0.0}}
     tips = {}
     for m_p in (0.0, 1000.0):

@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 
+from sim_core import run_control
 from sim_core.errors import ElementEvaluationError, SimulationError
 from sim_core.integrate.checks import ENERGY_FAIL, ENERGY_SUSPECT, STORED_FLOOR, verdict
 from sim_core.integrate.driver import integrate, run_with_partial
@@ -69,8 +70,9 @@ def beam_energy_check(model, scene: dict, res: Result) -> dict:
     fed = []
     moving = [c for c in model.constraints if not c.constant]
     if moving:
+        # every loop over the outputs checks the run's wall budget and Ctrl-C (run_control)
         P += np.array([float(np.dot(np.real(res["reactions"][k]), model.linear_targets(t, 1)))
-                       for k, t in enumerate(ts)])
+                       for k, t in run_control.checked(enumerate(ts))])
         fed.append("prescribed motion")
     for bc in scene.get("boundary", []):
         if bc["kind"] != "sleeve" or bc["speed"] == 0.0:
@@ -80,19 +82,19 @@ def beam_energy_check(model, scene: dict, res: Result) -> dict:
         bps = scene["beams"][bc["beam"]]["breakpoints"]
         s0, sign = (bps[0], -1.0) if bc["end"] == "left" else (bps[-1], 1.0)
         motion = sleeve_motion(bc, s0)
-        for k, (t, y) in enumerate(zip(ts, Y)):
+        for k, (t, y) in run_control.checked(enumerate(zip(ts, Y))):
             s_b, rate, _ = motion(t)
             P[k] += sign * rate * _kinetic_density(model, bc["beam"], s_b, t, y)
         if "material flow" not in fed:
             fed.append("material flow")
     for pl_scene, pl in zip(scene.get("point_loads", []), model.point_loads):
         if pl_scene["speed"] == 0.0 and pl_scene["start"] <= 0.0:
-            for k, (t, y) in enumerate(zip(ts, Y)):
+            for k, (t, y) in run_control.checked(enumerate(zip(ts, Y))):
                 Q, _ = model.full_state(t, y[:n], y[n:])
                 r, _, _ = model.point(pl.beam, pl.s_of_t(t), Q)
                 V[k] -= float(np.dot(np.asarray(pl.force(t), float), np.real(r)))
         else:
-            for k, (t, y) in enumerate(zip(ts, Y)):
+            for k, (t, y) in run_control.checked(enumerate(zip(ts, Y))):
                 _, v, _ = model.point_motion(pl.beam, pl.s_of_t(t), t, y[:n], y[n:])
                 P[k] += float(np.dot(np.asarray(pl.force(t), float), np.real(v)))
             fed.append("point load")
@@ -116,6 +118,7 @@ def beam_energy_check(model, scene: dict, res: Result) -> dict:
     return {"energy_balance": verdict(value, ENERGY_SUSPECT + q, ENERGY_FAIL + q, what)}
 
 
+@run_control.budgeted
 def run(scene: dict, progress=None, checkpoint=None) -> Result:
     """Integrate a validated beam scene (:func:`sim_core.systems.beam.schema.validate`) from
     its initial state (or its static equilibrium) and return a Result.
@@ -158,7 +161,10 @@ def _beam_result(model, scene, ts, ys, stats, error) -> Result:
                                             "energy_kinetic", "energy_strain", "energy_gravity",
                                             "element_ends", "reactions")}
     failure = None
+    stop = run_control.OutputGuard(partial=error is not None)    # the run's budget, Ctrl-C
     for t, y in zip(ts, ys):
+        if stop(t):
+            break
         z, zd = y[:n], y[n:]
         try:
             with np.errstate(over="raise", divide="raise", invalid="raise", under="ignore"):
@@ -200,4 +206,4 @@ def _beam_result(model, scene, ts, ys, stats, error) -> Result:
         res.error = str(exc)
         exc.result = res
         raise exc
-    return res
+    return stop.finish(res)

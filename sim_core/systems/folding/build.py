@@ -74,6 +74,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from sim_core import run_control
 from sim_core.model.boundary import LinearConstraint, boundary_condition
 from sim_core.model.model import Model
 from sim_core.physics.beam.moving_node_beam import Beam, BeamSection
@@ -533,6 +534,7 @@ def scaled_static_equilibrium(m: Model, z0: np.ndarray, t: float = 0.0, k_ref: f
         r1 = Fr + C.T @ lam
         if np.linalg.norm(r1) <= tol * scale and np.max(np.abs(phi), initial=0.0) < 1e-10:
             return z, lam
+        run_control.check("statics", t)             # the run's budget and Ctrl-C
         K = force_tangent(parts, z, lam, rel_step=1e-7, r0=r1)       # forward differences
         A = np.block([[K, C.T], [C, np.zeros((mm, mm))]])
         d = S * np.linalg.solve(S[:, None] * A * S[None, :], -S * np.concatenate([r1, phi]))
@@ -608,7 +610,10 @@ def folding_result(fs: FoldingSystem, t, ys, stats, error, scene=None):
                            "slew_angle", "boom_angles", "constraint_violation",
                            "angular_momentum")}
     tip = fs.frames["boom2_tip"]
+    stop = run_control.OutputGuard(partial=error is not None)    # the run's budget, Ctrl-C
     for tk, y in zip(t, ys):
+        if stop(tk):
+            break
         z, zd = y[:n], y[n:]
         Q, Qd = m.full_state(tk, z, zd)
         r, J, _, _ = tip(Q)
@@ -642,4 +647,5 @@ def folding_result(fs: FoldingSystem, t, ys, stats, error, scene=None):
     stats["n_dof"] = int(n)
     if scene is None:
         scene = {"kind": "folding", "name": "folding", "params": dict(p.__dict__)}
-    return Result(np.asarray(t), outputs, stats, scene, error)
+    k = len(out["tip_position"])
+    return stop.finish(Result(np.asarray(t)[:k], outputs, stats, scene, error))

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from sim_core import run_control
 from sim_core.figures import plot_result
 from sim_core.result import Result
 from sim_core.systems.folding.build import build_folding, simulate_folding
@@ -19,6 +20,7 @@ def build(scene: dict):
     return build_folding(params_from_scene(scene))
 
 
+@run_control.budgeted
 def run(scene: dict, progress=None, checkpoint=None) -> Result:
     """The manipulator from its static equilibrium through the drive stages; ``checkpoint``
     (:class:`sim_core.checkpoint.Checkpointer` or None): the integration writes to it and

@@ -37,6 +37,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from sim_core import run_control
 from sim_core.model.boundary import (
     LinearConstraint,
     boundary_condition,
@@ -62,8 +63,9 @@ from sim_core.physics.hydraulic_cylinder import OilColumn
 from sim_core.physics.point_effects import PointMass, RopeDrive, SliderSeat
 from sim_core.physics.rigid_body import beam_frame, revolute_axis, turntable_frame
 from sim_core.systems.telescopic.luffing import cylinder_drive, luffing_geometry
-from sim_core.systems.telescopic.params import TelescopicParams, boom_section
-from sim_core.systems.telescopic.sliders import slider_geometries
+from sim_core.systems.telescopic.params import STAGEWISE, TelescopicParams, boom_section
+from sim_core.systems.telescopic.sliders import overlap_pads, slider_geometries
+from sim_core.systems.telescopic.telescoping import cylinder_stage
 
 
 @dataclass
@@ -85,6 +87,7 @@ class TelescopicSystem:
     ropes: list = field(default_factory=list)   # (extraction, retraction) RopeDrive per unit
     stages: list = field(default_factory=list)  # schedule of each stage k (boom k -> k+1)
     hoist: object = None                        # physics.hoist.HoistRope (payload_swing)
+    ground: object = None                       # physics.ground_contact.GroundContact
 
     def section_outline(self, k: int) -> np.ndarray:
         """Boom k's outer contour in section coordinates, m (for loads on its surface)."""
@@ -106,15 +109,21 @@ class TelescopicSystem:
 def _section_outline(ts: "TelescopicSystem", k: int) -> np.ndarray:
     """Boom k's outer contour (n, 2) in section coordinates (e_t, e_b), m: its section's, or
     for the shorthand the U family's Table 1 contour (outer radii)."""
+    return boom_cross_section(ts.params, k).outer
+
+
+def boom_cross_section(p: TelescopicParams, k: int):
+    """Boom k's :class:`~sim_core.physics.cross_sections.CrossSection` (0-based k): the
+    [[boom]] table's (None for given properties), or for the shorthand the U family's Table 1
+    section (outer radii)."""
     from sim_core.physics.cross_sections import cross_section
-    p = ts.params
     if p.booms is not None:
-        return p.booms[k].section.outer
+        return p.booms[k].section
     from sim_core.systems.telescopic.params import _Y_A, _WALL, family_radius
     # two shorthand booms are the paper's booms 1 and 2 (params.crane_sections)
     r = family_radius(k, max(p.n_booms, 3))
     return cross_section({"shape": "u", "top_arc_centre_y": _Y_A, "top_arc_centre_z": _Y_A,
-                          "top_arc_radius": r, "wall": _WALL}, method="closed form").outer
+                          "top_arc_radius": r, "wall": _WALL}, method="closed form")
 
 
 def drive_layout(n_booms: int, mechanism: str) -> tuple[list[int], list[int]]:
@@ -125,8 +134,9 @@ def drive_layout(n_booms: int, mechanism: str) -> tuple[list[int], list[int]]:
     boom: cylinders on stages 0, 2, 4, ..., rope units on booms 2, 4, ...  ``sequential``: one
     cylinder moves one stage at a time while locking pins hold the others; every stage is a
     prescribed length (the active one on its schedule, the locked ones constant) and there are
-    no ropes."""
-    if mechanism == "sequential":
+    no ropes; so are ``independent`` and ``single_cylinder`` (sim_core.systems.telescopic.
+    telescoping)."""
+    if mechanism in STAGEWISE:
         return list(range(n_booms - 1)), []
     return list(range(0, n_booms - 1, 2)), list(range(2, n_booms, 2))
 
@@ -134,7 +144,7 @@ def drive_layout(n_booms: int, mechanism: str) -> tuple[list[int], list[int]]:
 def drive_name(stage: int, mechanism: str) -> str:
     """Constraint name of the prescribed length of stage ``stage`` (boom stage+1 -> stage+2)."""
     pair = f"{stage + 1}{stage + 2}"
-    if mechanism == "sequential":
+    if mechanism in STAGEWISE:
         return f"stage_{pair}"
     return "telescopic_cylinder" if stage == 0 else f"telescopic_cylinder_{pair}"
 
@@ -178,6 +188,8 @@ def stage_schedules(p: TelescopicParams) -> list[CubicSmoothstepSchedule]:
     of its neighbour, then inwards), retraction the reverse order; a stage outside its window
     holds its length (a locked pin)."""
     n = p.n_booms - 1
+    if p.stage_profiles is not None:              # each stage its own (telescoping.py)
+        return list(p.stage_profiles)
     if p.drive_profile is not None:               # a [drive] profile (actuators): every stage
         return [p.drive_profile] * n
     if p.mechanism != "sequential":
@@ -217,6 +229,12 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
     e = np.asarray(geo.e_s, float)
     O1 = np.asarray(geo.origin, float)
     Lk, N, Ls = p.lengths, p.n_booms, p.stroke0
+    # the stage lengths at t = 0 and boom k's left section a_k along boom 1: k L_s, or the sum of
+    # the stages' own initial lengths where each stage has a profile (telescoping.py)
+    ls0, a0 = [Ls] * (N - 1), [k * Ls for k in range(N)]
+    if p.stage_profiles is not None:
+        ls0 = [float(pr.sample(0.0).s) for pr in p.stage_profiles]
+        a0 = [0.0, *np.cumsum(ls0)]
     d_in = [o.inner_distance for o in p.overlaps]     # slider centres from the boom ends, m
     d_out = [o.outer_distance for o in p.overlaps]
     G = reference_basis(e)
@@ -224,7 +242,7 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
     for k in range(N):
         # boom 1 splits at the luffing point, boom k+1 at the outer contact point s_3,k+1 =
         # L_k - d_out - L_s (Eq. 50; the paper's L - L_s)
-        split = p.L_h if k == 0 else (Lk[k - 1] - d_out[k - 1]) - Ls
+        split = p.L_h if k == 0 else (Lk[k - 1] - d_out[k - 1]) - ls0[k - 1]
         beams.append(Beam(f"boom{k + 1}", Lk[k], boom_section(k, p), (0.0, split, Lk[k]),
                           n_nodes=p.n_nodes, n_gauss=p.n_gauss, reference_basis=G))
     offsets = np.cumsum([0] + [b.n_coords for b in beams])[:-1]
@@ -254,10 +272,10 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
     # (docs/model.md#input-ropes)
     Q0 = np.zeros(model.n_coords)
     for k, b in enumerate(beams):
-        Q0[offsets[k]:offsets[k] + b.n_coords] = b.straight_coordinates(O1 + k * Ls * e, e)
+        Q0[offsets[k]:offsets[k] + b.n_coords] = b.straight_coordinates(O1 + a0[k] * e, e)
     n_beam = int(sum(b.n_coords for b in beams))
     s2_index = [n_beam + k for k in range(N - 1)]
-    Q0[s2_index] = [Ls + d for d in d_in]
+    Q0[s2_index] = [x + d for x, d in zip(ls0, d_in)]
     s3_index = [int(offsets[k] + beams[k].s_coord(1)) for k in range(N)]
 
     def mp(k, **kw):
@@ -360,7 +378,7 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
 
     tip = mp(N - 1, s_fixed=Lk[N - 1])
     pe = []
-    hoist = None
+    hoist = ground = None
     if p.payload_swing:
         # the payload and hook on the hoist rope (sim_core.physics.hoist): their position is
         # three coordinates after the contact points, starting below the tip on the rope
@@ -372,6 +390,9 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
         Q0[ip:ip + 3] = np.real(tip(Q0)[0]) - np.array([0.0, 0.0, L_static])
         hoist = HoistRope(tip, free_point(ip, model.n_coords), p.hoist_EA, _length_of(L0))
         pe += [HangingMass(ip, m_hang, g_vec if p.gravity > 0 else None), hoist]
+        if p.ground is not None:
+            ground = _ground_under_payload(p, ip, m_hang, Q0, tip)
+            pe.append(ground)
     elif p.payload > 0:
         pe.append(PointMass(tip, p.payload, g_vec if p.gravity > 0 else None))
     ropes = []
@@ -409,7 +430,7 @@ def build_telescopic(p: TelescopicParams) -> TelescopicSystem:
     ts = TelescopicSystem(model, Q0, sched, s2_index, s3_index, rows, tip, p,
                           angle_rows=angle_rows, seats=seats, drives=drives, ropes=ropes,
                           oil_columns=columns,
-                          stages=stages, hoist=hoist, i_phi=i_phi,
+                          stages=stages, hoist=hoist, ground=ground, i_phi=i_phi,
                           slew_angle=None if i_phi is None else
                           (lambda t, prof=p.slew_profile: float(prof.sample(t).s)))
     # Section 8 contact analysis: the slider springs on every overlap's bearing patches
@@ -507,6 +528,57 @@ def _replay_geometry(ts: TelescopicSystem, t, ys) -> dict:
             "geometry_section_outlines": np.broadcast_to(padded, padded.shape).copy()}
 
 
+def _ground_under_payload(p: TelescopicParams, ip: int, m_hang: float, Q0, tip):
+    """The ground of effects.ground (physics.ground_contact) under the payload on the
+    coordinates ip..ip+2, which starts on it, below the tip, pressed in by its weight."""
+    from sim_core.physics.ground_contact import GroundContact, resting_penetration
+    gr = p.ground
+    ground = GroundContact(ip, gr["height"], gr["stiffness"], gr["damping"], gr["ramp_width"])
+    r_tip = np.real(tip(Q0)[0])
+    Q0[ip:ip + 3] = [r_tip[0], r_tip[1],
+                     gr["height"] - resting_penetration(ground, m_hang * p.gravity)]
+    return ground
+
+
+#: section-force stations per boom (equally spaced material points, both ends included)
+SECTION_STATIONS = 21
+
+
+def _section_outputs(ts: TelescopicSystem, t, ys) -> dict:
+    """The booms' internal forces and stresses at every output time
+    (docs/user_guide.md#section-forces-and-stresses):
+
+    * ``section_stations`` (N, S): the stations' material coordinates, m (S =
+      SECTION_STATIONS equally spaced points of each boom, ends included);
+    * ``section_forces`` (n, N, S, 6): (N, Q_t, Q_b, T, M_t, M_b) in the section frame, N and
+      N m (:mod:`sim_core.physics.beam.section_forces`);
+    * ``section_stress`` (n, N, S, K, 2): normal stress and shear-stress magnitude at the K
+      outline points of each boom's section, Pa; ``section_stress_points`` (N, K, 2): those
+      points (e_t, e_b), m (:mod:`sim_core.physics.section_stress`);
+    * ``section_utilisation`` (n, N, S): the largest von Mises stress of the section over the
+      yield strength ``material.f_y``.
+    A boom given by its constants (no geometry) has NaN stresses."""
+    from sim_core.physics.beam.section_forces import model_section_forces
+    from sim_core.physics.section_stress import OUTLINE_POINTS, stress_table, utilisation
+    m, p = ts.model, ts.params
+    n = m.n_dof
+    stations = np.array([np.linspace(0.0, L, SECTION_STATIONS) for L in p.lengths])
+    forces = np.array([model_section_forces(m, m.full_state(tk, y[:n], y[n:])[0], stations)
+                       for tk, y in zip(t, ys)]).reshape(len(t), p.n_booms, SECTION_STATIONS, 6)
+    stress = np.full(forces.shape[:3] + (OUTLINE_POINTS, 2), np.nan)
+    points = np.full((p.n_booms, OUTLINE_POINTS, 2), np.nan)
+    for k in range(p.n_booms):
+        cs = boom_cross_section(p, k)
+        if cs is None:
+            continue
+        table = stress_table(cs)
+        stress[:, k, :, :, 0], stress[:, k, :, :, 1] = table.stresses(forces[:, k])
+        points[k] = table.points
+    return {"section_stations": stations, "section_forces": forces, "section_stress": stress,
+            "section_stress_points": points,
+            "section_utilisation": utilisation(stress[..., 0], stress[..., 1], p.f_y)}
+
+
 def _payload_outputs(ts: TelescopicSystem, t: float, Q, r_tip, out: dict) -> None:
     """payload_position (m), sway_angle (rad: from the vertical in the luffing plane and across
     it, the plane turned by the slew angle) and hoist_rope_force (N) at one output time."""
@@ -600,6 +672,13 @@ def _oil_column_equilibrium(ts: TelescopicSystem, t: float):
 
 
 def _initial_equilibrium(ts: TelescopicSystem, t: float):
+    if ts.ground is not None:            # the payload on the ground (physics.ground_contact)
+        from sim_core.physics.ground_contact import resting_equilibrium
+        return resting_equilibrium(ts, t, _rope_equilibrium)
+    return _rope_equilibrium(ts, t)
+
+
+def _rope_equilibrium(ts: TelescopicSystem, t: float):
     from sim_core.model.statics import constrained_static_equilibrium
     m = ts.model
     z0, _ = m.reduced_state(t, ts.Q0, np.zeros_like(ts.Q0))
@@ -702,7 +781,10 @@ def _telescopic_result(ts: TelescopicSystem, t, ys, stats, error, scene=None):
     basis = m.beams[0].reference_basis
     lefts = [material_point(m, k, s_fixed=0.0) for k in range(N)]
     out["luffing_angle"] = []
+    stop = run_control.OutputGuard(partial=error is not None)    # the run's budget, Ctrl-C
     for tk, y in zip(t, ys):
+        if stop(tk):
+            break
         z, zd = y[:n], y[n:]
         zdd, lam = m.accelerations_and_multipliers(tk, z, zd)
         Q, Qd = m.full_state(tk, z, zd)
@@ -716,7 +798,8 @@ def _telescopic_result(ts: TelescopicSystem, t, ys, stats, error, scene=None):
         stroke = [np.linalg.norm(a[k + 1] - a[k]) - p.stroke0 for k in range(N - 1)]
         forces = [ts.oil_columns[name].force(tk, Q, Qd) if name in ts.oil_columns
                   else lam[ts.rows[name]][0] for name in ts.drives]
-        cyl = active_stage(ts, tk) if p.mechanism == "sequential" else 0
+        cyl = (active_stage(ts, tk) if p.mechanism == "sequential" else
+               cylinder_stage(p.cylinder_moves, tk) if p.cylinder_moves else 0)
         out["stage_stroke"].append(stroke)
         out["drive_forces"].append(forces)
         out["piston_stroke"].append(stroke[cyl])
@@ -741,6 +824,11 @@ def _telescopic_result(ts: TelescopicSystem, t, ys, stats, error, scene=None):
                 n_max = max(f.size for f in forces)
                 out.setdefault("slider_contact_forces", []).append(
                     [np.pad(f, (0, n_max - f.size), constant_values=np.nan) for f in forces])
+                # the springs summed pad by pad (sliders.overlap_pads): the force and couple
+                # each pad puts on its overlap's inner boom, and its springs' sum per patch
+                pads = overlap_pads(ts.contact, sols)
+                for key, v in zip(("pad_forces", "pad_couples", "pad_face_forces"), pads):
+                    out.setdefault(key, []).append(v)
             if p.friction:
                 out.setdefault("friction_coefficient", []).append([mu for _, _, mu, _ in sols])
         if "rope" in ts.rows:
@@ -755,15 +843,23 @@ def _telescopic_result(ts: TelescopicSystem, t, ys, stats, error, scene=None):
             out.setdefault("slew_angle", []).append(float(np.real(Q[ts.i_phi])))
         if ts.hoist is not None:
             _payload_outputs(ts, tk, Q, r, out)
+        if ts.ground is not None:
+            out.setdefault("payload_ground_force", []).append(ts.ground.force(Q, Qd))
         out["inner_contact_s"].append(Q[ts.s2_index])
         out["outer_contact_s"].append(Q[ts.s3_index[1:]])
         out["constraint_violation"].append(np.max(np.abs(m.constraint_violation(tk, z, zd))))
+    if stop.error is not None:        # cut by the budget or Ctrl-C: the output times reached
+        t, ys = np.asarray(t)[:len(out["tip_position"])], np.asarray(ys)[:len(out["tip_position"])]
     outputs = {k: np.array(v, dtype=float) for k, v in out.items()}
     # the integrated states at the output times (the energy check of the result re-evaluates
-    # the energies from them, simulate.telescopic_energy_check)
-    outputs.update(_replay_geometry(ts, t, ys))
+    # the energies from them, simulate.telescopic_energy_check); no replay geometry and no
+    # section forces for outputs cut short by the budget (its time is spent)
+    if stop.error is None:
+        outputs.update(_replay_geometry(ts, t, ys))
+        outputs.update(_section_outputs(ts, t, ys))
     outputs["state"] = np.asarray(ys, dtype=float)
     stats["n_dof"] = int(n)
     if m.uncompiled_effects:
         stats["uncompiled_effects"] = m.uncompiled_effects
-    return Result(t, outputs, stats, scene if scene is not None else p.summary(), error)
+    return stop.finish(Result(t, outputs, stats, scene if scene is not None else p.summary(),
+                              error))

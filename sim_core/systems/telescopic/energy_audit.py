@@ -18,6 +18,9 @@ of the inertia forces, which does no work on the material kinetic energy T
   the level of the integrator's error.
 * ``P_friction = Q_dot . F_friction <= 0`` (Section 8.3: -mu(s_dot) N s_dot on each contact
   coordinate; mu is odd in s_dot), the friction dissipation.
+* ``P_friction`` also holds the ground's damper under a payload on the ground
+  (effect ``ground``, :mod:`sim_core.physics.ground_contact`): -P_diss <= 0, while its spring's
+  strain energy is part of E.
 * ``P_filter = Q_dot . (F_filter - M_filter Q_ddot)``: the stress filter (SIMULTECH 2020 Eq. 53,
   docs/model.md#input-filter) adds a mass-like term and rate forces; treated here as an applied
   force, so T stays the material kinetic energy of the booms.  Its integral is the energy the
@@ -34,8 +37,10 @@ import math
 
 import numpy as np
 
+from sim_core import run_control
 from sim_core.integrate.checks import ENERGY_FAIL, ENERGY_SUSPECT, verdict
 from sim_core.physics.constraints import constraint_terms
+from sim_core.physics.ground_contact import GroundContact
 from sim_core.physics.hoist import HangingMass, HoistRope
 from sim_core.physics.point_effects import RopeDrive, SliderSeat, ramp_energy
 from sim_core.result import Result
@@ -51,8 +56,9 @@ def rope_energy(rope: RopeDrive, ell: float) -> float:
 
 def mechanical_energy(ts, t: float, z: np.ndarray, zd: np.ndarray) -> float:
     """Material kinetic + strain + gravity energy of the booms, payload point mass (kinetic and
-    gravity), rope strain energy and the slider seats' strain energy, J.  The stress filter's mass-like term is not included
-    (it is accounted as the filter's work, see the module docstring)."""
+    gravity), rope strain energy, the slider seats' and the ground's strain energy, J.  The
+    stress filter's mass-like term is not included (it is accounted as the filter's work, see
+    the module docstring)."""
     m, p = ts.model, ts.params
     Q, Qd = m.full_state(t, z, zd)
     g = np.array([0.0, 0.0, -p.gravity])
@@ -71,6 +77,8 @@ def mechanical_energy(ts, t: float, z: np.ndarray, zd: np.ndarray) -> float:
             E += pe.energy(Q, Qd)
         elif isinstance(pe, HoistRope):
             E += pe.energy(Q, t)
+        elif isinstance(pe, GroundContact):        # the ground spring under the payload
+            E += pe.energy(Q)
     return float(np.real(E))
 
 
@@ -157,6 +165,8 @@ class AuditedSystem:
             P["friction_work"] = (float(Qd @ sum(mf.forces(t, Q, Qd, lam)
                                                  for mf in m.multiplier_forces))
                                   if m.multiplier_forces else 0.0)
+            if self.ts.ground is not None:      # the ground's damper (ground_contact)
+                P["friction_work"] -= self.ts.ground.dissipation(Q, Qd)
         if "filter_work" in self.terms:
             P["filter_work"] = 0.0
             if self.filter is not None:
@@ -234,15 +244,18 @@ def telescopic_energy_check(ts, res: Result) -> dict:
     ts_, Y = np.asarray(res.t, dtype=float), np.asarray(res["state"])
     audit = AuditedSystem(ts, ("drive_work",))
     n = audit.n
-    E = np.array([mechanical_energy(ts, t, y[:n], y[n:2 * n]) for t, y in zip(ts_, Y)])
+    # every loop over the outputs checks the run's wall budget and Ctrl-C (run_control)
+    E = np.array([mechanical_energy(ts, t, y[:n], y[n:2 * n])
+                  for t, y in run_control.checked(zip(ts_, Y))])
     P = None if ts.i_phi is not None or ts.plugin_effects or ts.oil_columns else \
         _drive_power_of_outputs(ts, audit, res)
     if P is None:
-        P = np.array([audit.powers(t, y[:n], y[n:2 * n])[1][0] for t, y in zip(ts_, Y)])
+        P = np.array([audit.powers(t, y[:n], y[n:2 * n])[1][0]
+                      for t, y in run_control.checked(zip(ts_, Y))])
     elif ts.params.luffing_profile is not None or ts.hoist is not None:
         lam_l = np.asarray(res["luffing_cylinder_force"], dtype=float)
         P = P + np.array([actuator_power(ts, t, ts.model.full_state(t, y[:n], y[n:2 * n])[0], lam)
-                          for t, y, lam in zip(ts_, Y, lam_l)])
+                          for t, y, lam in run_control.checked(zip(ts_, Y, lam_l))])
     W = np.concatenate([[0.0], np.cumsum(0.5 * (P[1:] + P[:-1]) * np.diff(ts_))])
     quad = 0.0
     if len(ts_) >= 3:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from sim_core import run_control
 from sim_core.figures import plot_result
 from sim_core.result import Result
 from sim_core.systems.telescopic.build import build_telescopic, simulate_telescopic
@@ -26,6 +27,7 @@ def build(scene: dict):
     return build_telescopic(params) if params.flexible else RigidTelescopic(params)
 
 
+@run_control.budgeted
 def run(scene: dict, progress=None, checkpoint=None) -> Result:
     """The scene's fidelity: the modal ROM, the rigid limit or the flexible booms.
     ``checkpoint`` (:class:`sim_core.checkpoint.Checkpointer` or None): the flexible booms'

@@ -13,7 +13,11 @@ from sim_core.physics.sections import USection, section_properties
 TABLE2 = ((7.22e8, 5.55e8, 318.86), (6.30e8, 4.85e8, 304.07), (5.46e8, 4.20e8, 289.27))
 Z_C_TABLE2 = (0.045, 0.044, 0.043)          # m, mass centre along e_b (Table 2)
 MAX_BOOMS = 6                               # sections of the longest crane the scenes accept
-MECHANISMS = ("synchronized", "sequential")  # telescoping drives (docs/model.md, "N-boom drives")
+MECHANISMS = ("synchronized", "sequential", "independent",
+              "single_cylinder")          # telescoping drives (docs/model.md, "N-boom drives")
+#: the drives whose every stage is a prescribed length of its own (no rope units):
+#: sim_core.systems.telescopic.telescoping
+STAGEWISE = ("sequential", "independent", "single_cylinder")
 
 # Table 1 family: top arcs centred at y_a = z_a = 0.300 m, wall t = 15 mm, top-arc radius r of
 # boom k (from the outermost) 20 mm above boom k+1's, so adjacent walls keep a 5 mm radial gap
@@ -152,6 +156,7 @@ class TelescopicParams:
     mechanism: str = "synchronized"         # telescoping drive of MECHANISMS (N >= 3)
     flexible: bool = True                   # flexible booms; off = rigid kinematic limit
     mass_centre_offset: bool = False        # Table 2 z_c as rigid offset (docs/model.md#input-sections)
+    f_y: float = 355e6                      # Pa, the booms' yield strength (section_utilisation)
     z_c: tuple | None = None                # m, mass centre along e_b (None: crane_sections)
     mu_static: float = 0.15
     mu_dynamic: float = 0.1
@@ -179,10 +184,18 @@ class TelescopicParams:
     hoist_length: float = 10.0              # m, unstretched hoist rope at t = 0
     hoist_EA: float = 2e8                   # N
     hook_mass: float = 500.0                # kg
+    # the ground under the swinging payload (physics.ground_contact): None = no ground; else
+    # {height m, stiffness N/m, damping N s/m, ramp_width m}
+    ground: dict | None = None
     # the telescopic cylinder's oil column (physics.hydraulic_cylinder): None = the stage
     # length follows the drive exactly; else {cylinder_area m^2, bulk_modulus Pa, dead_length m,
     # damping_ratio}
     oil_column: dict | None = None
+    # mechanisms "independent" and "single_cylinder" (sim_core.systems.telescopic.telescoping):
+    # each stage's length L_s,k(t) (m, a profile of physics.drive_profiles, stage 0 = boom 2 in
+    # boom 1) and the single cylinder's moves (t_start s, t_end s, stage)
+    stage_profiles: tuple | None = None
+    cylinder_moves: tuple | None = None
     plugin_tables: dict = field(default_factory=dict)  # effect plug-ins on: name -> table
 
     def __post_init__(self):
@@ -220,7 +233,8 @@ class TelescopicParams:
     def summary(self, name: str = "telescopic") -> dict:
         """What a Result records as its scene where it was run from parameters, not a scene."""
         skip = ("sections", "booms", "overlaps", "luffing", "drive_profile", "luffing_profile",
-                "slew_profile", "hoist_profile", "plugin_tables")
+                "slew_profile", "hoist_profile", "plugin_tables", "stage_profiles",
+                "cylinder_moves")
         return {"kind": "telescopic", "name": name,
                 "params": {k: v for k, v in self.__dict__.items() if k not in skip}}
 

@@ -62,6 +62,10 @@ def rigid_tip_travel(result: Result) -> np.ndarray:
     n, mech = _drive(result)
     if mech == "sequential" and "stage_stroke" in result:
         return np.sum(result["stage_stroke"], axis=1)
+    if mech in ("independent", "single_cylinder") and "stage_stroke" in result:
+        # every stage on its own profile, from its own length at t = 0
+        s = np.asarray(result["stage_stroke"], float)
+        return np.sum(s - s[0], axis=1)
     return (n - 1) * np.asarray(result["piston_stroke"], float)
 
 
@@ -79,7 +83,12 @@ def plot_telescopic(result: Result, out: str | Path, slider_times=None) -> list[
     * ``slider_contact_forces.png`` (Fig. 26): normal force of every slider spring of every
       region at chosen times (default: t_end / 4, t_end / 2, 0.8 t_end = 16 s of the paper's
       20 s, t_end), springs numbered patch by patch (arcs, then faces) as in
-      ``sim_core.physics.contact``; regions with fewer springs are padded with NaN.
+      ``sim_core.physics.contact``; regions with fewer springs are padded with NaN (not for a
+      crane described boom by boom: it has ``pad_forces.png`` instead);
+    * ``pad_forces.png``: the force each pad puts on its overlap's inner boom (f_b in the
+      luffing plane, f_t across it) and the couple it carries across its length, one row per
+      overlap, labelled "overlap k outer pad" / "overlap k inner pad"
+      (:func:`sim_core.systems.telescopic.sliders.overlap_pads`).
     """
     import matplotlib
     matplotlib.use("Agg")
@@ -155,7 +164,12 @@ def plot_telescopic(result: Result, out: str | Path, slider_times=None) -> list[
         fig.tight_layout()
         paths.append(save_figure(fig, out / "drive_forces.png"))
         plt.close(fig)
-    if "slider_contact_forces" in result:
+    if "pad_forces" in result:
+        paths.append(_pad_figure(result, out, plt))
+    if "slider_contact_forces" in result and not (
+            "pad_forces" in result and result.scene.get("boom")):
+        # the paper's Fig. 26 (spring by spring); a crane described boom by boom has the
+        # pad figure instead
         sf = result["slider_contact_forces"]            # (n, regions, springs)
         wanted = slider_times if slider_times is not None else \
             [t[-1] / 4, t[-1] / 2, 0.8 * t[-1], t[-1]]
@@ -176,6 +190,44 @@ def plot_telescopic(result: Result, out: str | Path, slider_times=None) -> list[
         plt.close(fig)
     paths += _operation_figures(result, out, plt)
     return paths
+
+
+def _pad_figure(result: Result, out: Path, plt) -> Path:
+    """``pad_forces.png`` (see :func:`plot_telescopic`): per overlap, the pads' forces on the
+    inner boom (kN) and the couples they carry (kN m) over time."""
+    from sim_core.systems.telescopic.sliders import PAD_NAMES
+    t = result.t
+    F = np.asarray(result["pad_forces"], float)         # (n, overlaps, 2 pads, (f_t, f_b))
+    C = np.asarray(result["pad_couples"], float) if "pad_couples" in result else None
+    n_ov = F.shape[1]
+    fig, axes = plt.subplots(n_ov, 2, figsize=(12, 2.6 * n_ov + 0.8), sharex=True,
+                             squeeze=False)
+    for k in range(n_ov):
+        for j, pad in enumerate(PAD_NAMES):
+            label = f"overlap {k + 1} {pad}"
+            line, = axes[k, 0].plot(t, F[:, k, j, 1] / 1e3, label=f"{label}, f_b")
+            axes[k, 0].plot(t, F[:, k, j, 0] / 1e3, ":", color=line.get_color(),
+                            label=f"{label}, f_t")
+            if C is not None:
+                axes[k, 1].plot(t, C[:, k, j, 0] / 1e3, color=line.get_color(),
+                                label=f"{label}, m_t")
+        axes[k, 0].set_ylabel("force [kN]")
+        axes[k, 1].set_ylabel("couple [kN m]")
+        axes[k, 0].set_title(f"overlap {k + 1} (booms {k + 1}-{k + 2}): pad forces on boom "
+                             f"{k + 2}", fontsize=9)
+        axes[k, 1].set_title(f"overlap {k + 1}: couples across the pads", fontsize=9)
+    for ax in axes[-1]:
+        ax.set_xlabel("t [s]")
+    for ax in axes.ravel():
+        ax.grid(alpha=0.3)
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(loc="best", fontsize=6)
+    fig.suptitle("slider pads: force on the inner boom (contact-section frame: e_b in the "
+                 "luffing plane, e_t across) and couple about e_t")
+    fig.tight_layout()
+    path = save_figure(fig, out / "pad_forces.png")
+    plt.close(fig)
+    return path
 
 
 def _operation_figures(result: Result, out: Path, plt) -> list[Path]:

@@ -37,7 +37,7 @@ from sim_core.scene.fields import (
     text_fields,
     time_field,
 )
-from sim_core.systems.telescopic import actuators
+from sim_core.systems.telescopic import actuators, telescoping
 from sim_core.systems.telescopic.params import (
     MAX_BOOMS,
     MECHANISMS,
@@ -62,7 +62,8 @@ E_RANGE, RHO_RANGE = dict(lo=1e8, hi=1e15), dict(lo=10.0, hi=1e5)
 TOP = Table("", (Field("kind", "choice", choices=("telescopic",)), *text_fields("telescopic")),
             tables=("solver", "booms", "boom", "luffing", "drive", "payload", "ropes",
                     "effects", "contact", "overlap", "filtering", "gravity", "luffing_drive",
-                    "slew_drive", "hoist_drive", "hoist", "oil_column", "model"))
+                    "slew_drive", "hoist_drive", "hoist", "oil_column", "model", "ground",
+                    "stage_drive", "telescoping", "material"))
 #: the error-controlled methods and the Rosenbrock-W training integrator (fixed step)
 TELESCOPIC_METHODS = ERROR_CONTROLLED + ("ROS2",)
 SOLVER = solver_fields(t_end=20.0, atol=1e-7, methods=TELESCOPIC_METHODS)
@@ -187,7 +188,10 @@ def actuator_table(name: str, unit: str, travel: tuple, rate: float, accel: floa
                   note="\"synchronized\": the paper's cylinder-and-rope unit repeated along "
                        "the boom, every stage moves together; \"sequential\": one cylinder "
                        "moves one stage at a time, the others pinned (docs/model.md, \"N-boom "
-                       "drives\")"),
+                       "drives\"); \"independent\": a cylinder per stage on its own "
+                       "[[stage_drive]] profile; \"single_cylinder\": one cylinder moves one "
+                       "stage at a time between the pins of [telescoping] (docs/user_guide.md, "
+                       "\"Telescoping sequences\")"),
         ]
     fields += [
         Field("profile", "choice", default="cubic" if drive else "hold", choices=prof,
@@ -225,7 +229,9 @@ def actuator_table(name: str, unit: str, travel: tuple, rate: float, accel: floa
                    + ("; the first position is booms.stroke0" if drive else "")
                    + " (or table_file)"),
         Field("table_file", "string", default=OPTIONAL, when=tab, applies='profile "table"',
-              note="a CSV file of time and position, relative to the scene file"),
+              note="a CSV file of time and position, relative to the scene file; it lies "
+                   "inside the scene file's folder or a folder of BOOM_SIM_DATA_DIR, at most "
+                   "1 MiB and 20000 rows (docs/security.md)"),
         Field("max_rate", "number", f"{unit}/s", OPTIONAL, lo=1e-4, hi=rate,
               note="the actuator's rate limit, checked against the profile"),
         Field("max_accel", "number", f"{unit}/s^2", OPTIONAL, lo=1e-4, hi=accel,
@@ -249,10 +255,27 @@ HOIST_DRIVE = actuator_table(
     "the hoist: the unstretched hoist-rope length (m) from hoist.length; it stays at least "
     "0.1 m")
 ACTUATOR_TABLES = {t.path: t for t in (DRIVE, LUFFING_DRIVE, SLEW_DRIVE, HOIST_DRIVE)}
+_STAGE = actuator_table(
+    "stage_drive[]", "m", (-L_MAX, L_MAX), 5.0, 10.0, 100.0, (0.0, L_MAX),
+    'one stage\'s cylinder of drive.mechanism = "independent", one table per stage, stage 1 '
+    "(boom 2 in boom 1) first: the stage length L_s,k (m), the distance of the two booms' left "
+    "sections, from length0 (docs/user_guide.md, \"Telescoping sequences\")")
+STAGE_DRIVE = Table(_STAGE.path, (
+    Field("length0", "number", "m", COMPUTED, lo=1e-3, hi=L_MAX, default_text="booms.stroke0",
+          allowed="(0, shortest boom length) m; a table profile's first length",
+          note="the stage length at t = 0"), *_STAGE.fields), note=_STAGE.note)
+# each stage's table is read as an actuator table of its own name (stage_drive[k])
+ACTUATOR_TABLES.update({telescoping.stage_table(k): STAGE_DRIVE for k in range(MAX_BOOMS - 1)})
 
 PAYLOAD = Table("payload", (
     # the heaviest lifts of mobile cranes are ~1200 t
     Field("mass", "number", "kg", 25000.0, lo=0.0, hi=2e6, note="the payload at the tip"),
+))
+MATERIAL = Table("material", (
+    # from mild structural steel to the ultra-high-strength steels of crane booms (S1300)
+    Field("f_y", "number", "Pa", 355e6, lo=100e6, hi=2000e6,
+          note="yield strength of the booms (output section_utilisation = von Mises / f_y); "
+               "default S355"),
 ))
 ROPES = Table("ropes", (
     Field("EA", "number", "N", 1e8, **EA_RANGE, note="axial stiffness of the telescoping ropes"),
@@ -286,6 +309,9 @@ def _effects_table() -> Table:
         Field("payload_swing", "boolean", default=False,
               note="the payload and hook hang on the elastic hoist rope of [hoist] and swing; "
                    "false = a point mass fixed at the tip"),
+        Field("ground", "boolean", default=False,
+              note="the swinging payload stands on the ground of [ground] (unilateral "
+                   "spring-damper contact, output payload_ground_force): the lift-off load case"),
         Field("oil_column", "boolean", default=False,
               note="the telescopic cylinder drives its stage through the compressible oil of "
                    "[oil_column] (the stages can stick and slip on their sliders); false = the "
@@ -317,10 +343,15 @@ CONTACT = Table("contact", (
     Field("radial_gap", "number", "m", 0.005, lo=1e-4, hi=0.05,
           note="sliding-block thickness between the walls; sets the contact-circle radius "
                "(Table 1: 5 mm)"),
-    Field("moment_model", "choice", default="rigid", choices=("rigid", "seat", "couple"),
+    # the default: the model whose pad reactions and tip deflection are those of two-pad statics
+    # for a crane described boom by boom (docs/model.md#contact-models,
+    # tests/telescopic/test_pad_statics.py); the shorthand keeps Section 6 as printed
+    Field("moment_model", "choice", default=COMPUTED, choices=("rigid", "seat", "couple"),
+          default_text="\"couple\" for [[boom]] cranes, \"rigid\" for the [booms] shorthand",
           note="\"rigid\": Section 6, the contact sections' Cardan angles coincide; \"seat\": "
                "the two bending angles tied by an elastic seat of seat_stiffness; \"couple\": "
-               "the bending angles free, the overlap carries its moment as a force couple"),
+               "the bending angles free, the overlap carries its moment as a force couple "
+               "between its two pads (two-pad statics, what a design calculation assumes)"),
     # a polyamide pad (E = 3 GPa) 20 mm thick on a 0.3 m x 0.3 m footprint rocking about its
     # centre: E/t * b (2w)^3 / 12 = 1.0e8 N m/rad
     Field("seat_stiffness", "number", "N m/rad", 1e8, lo=1e3, hi=1e12,
@@ -358,6 +389,16 @@ HOIST = Table("hoist", (
     Field("EA", "number", "N", 2e8, **EA_RANGE, note="axial stiffness of the hoist rope"),
     Field("hook_mass", "number", "kg", 500.0, lo=0.0, hi=1e5, note="hangs with the payload"),
 ), note="the hoist rope of effects.payload_swing")
+GROUND = Table("ground", (
+    Field("height", "number", "m", 0.0, lo=-1000.0, hi=1000.0,
+          note="the ground plane Z = height in the crane's global frame (Z up)"),
+    Field("stiffness", "number", "N/m", 1e8, lo=1e3, hi=1e12,
+          note="penalty stiffness k of the contact (sim_core.physics.ground_contact)"),
+    Field("damping", "number", "N s/m", 1e5, lo=0.0, hi=1e9,
+          note="damper c of the contact, faded in over ramp_width; the force never pulls"),
+    Field("ramp_width", "number", "m", 1e-4, lo=1e-7, hi=0.1,
+          note="the spring's C1 ramp at first touch (as the ropes' slack_width)"),
+), note="the ground under the payload of effects.ground (the payload starts on it)")
 OIL_COLUMN = Table("oil_column", (
     Field("cylinder_area", "number", "m^2", 0.02, lo=1e-4, hi=1.0,
           note="piston area A"),
@@ -385,9 +426,10 @@ def _plugin_tables() -> tuple[Table, ...]:
 SCHEMA = Schema(
     "telescopic", 'Telescopic scenes (`kind = "telescopic"`)',
     "sim_core.systems.telescopic.schema.validate_telescopic",
-    (TOP, SOLVER, BOOMS, BOOM, SECTION, LUFFING, DRIVE, PAYLOAD, ROPES, EFFECTS, CONTACT,
-     OVERLAP, FILTERING, GRAVITY, LUFFING_DRIVE, SLEW_DRIVE, HOIST_DRIVE, HOIST, OIL_COLUMN,
-     MODEL,
+    (TOP, SOLVER, BOOMS, BOOM, SECTION, LUFFING, DRIVE, STAGE_DRIVE, telescoping.TELESCOPING,
+     PAYLOAD, MATERIAL, ROPES, EFFECTS, CONTACT,
+     OVERLAP, FILTERING, GRAVITY, LUFFING_DRIVE, SLEW_DRIVE, HOIST_DRIVE, HOIST, GROUND,
+     OIL_COLUMN, MODEL,
      *_plugin_tables()),
     rules=(
         "The stroke history keeps every boom inside its neighbour: 0 < L_s(t) < the shortest "
@@ -409,12 +451,18 @@ SCHEMA = Schema(
         "v_max, a_max, j_max to \"trapezoid\"; one of table or table_file to \"table\"); a "
         "travel is not 0; the profile's largest rate and acceleration stay within max_rate "
         "and max_accel.",
+        "drive.mechanism \"independent\" takes one [[stage_drive]] table per stage, "
+        "\"single_cylinder\" a [telescoping] table, and [drive] then holds only the mechanism; "
+        "the pins increase, every stage starts at a pin, every move takes an existing stage to "
+        "a pin other than its current one; every stage length stays in (0, the shortest boom "
+        "length) m and the sliders fit every overlap at the longest and shortest stage length.",
         "The slew keeps the boom's axis more than 15 deg from the lateral axis of the initial "
         "luffing plane, where the booms' Cardan angles are singular.",
         "[oil_column] needs effects.oil_column = true, which needs flexible booms, the "
         "synchronized drive and model.reduction = \"none\".",
         "[hoist] and [hoist_drive] need effects.payload_swing = true; a swinging payload needs "
         "a positive payload.mass + hoist.hook_mass.",
+        "[ground] needs effects.ground = true, which needs effects.payload_swing = true.",
         "effects.flexible = false (the rigid limit): booms.count 2 or 3, the synchronized "
         "drive, no friction, moment_model \"rigid\", no [[boom]] tables, no luffing, slewing or "
         "swinging payload.",
@@ -485,7 +533,12 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
     sc["drive"].update(_check_actuator(d, "drive"))
     L = Lmin
     what = "booms.length" if not boom_tables else "the shortest [[boom]] length"
-    if sc["drive"]["profile"] == "cubic":
+    telescoping.check_tables_belong(raw, sc["drive"]["mechanism"])
+    if sc["drive"]["mechanism"] in ("independent", "single_cylinder"):
+        # every stage on its own profile (telescoping.py)
+        ls_lo, ls_hi = telescoping.validate_stages(raw, sc, d, L, what)
+        end = ls_hi
+    elif sc["drive"]["profile"] == "cubic":
         travel = sc["drive"]["v_max"] * sc["drive"]["t_hold_end"]
         sign = 1 if sc["drive"]["direction"] == "extraction" else -1
         end = sc["booms"]["stroke0"] + sign * travel
@@ -518,6 +571,7 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
         actuators.check_limits("drive", sc["drive"], prof, sc["solver"]["t_end"])
         end = ls_hi if ls_hi != sc["booms"]["stroke0"] else ls_lo
     sc["payload"] = PAYLOAD.resolve(raw, "payload", ("mass",))
+    sc["material"] = MATERIAL.resolve(raw, "material", ("f_y",))
     sc["ropes"] = ROPES.resolve(raw, "ropes", ("EA",))
     e = table_of(raw, "effects", "")
     EFFECTS.check_keys(e, "effects")
@@ -526,7 +580,7 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
                                                           k == "contact_distribution" else {}))
                      for k in ("flexible", "torsion", "gravity", "filtering", "friction",
                                "contact_distribution", "rope_elasticity", "mass_centre_offset",
-                               "payload_swing", "oil_column")}
+                               "payload_swing", "oil_column", "ground")}
     for name in plugins:                # effect plug-ins (sim_core.physics.plugins): off unless on
         if name in e:
             sc["effects"][name] = EFFECTS.read(e, name, "effects")
@@ -550,10 +604,12 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
                              "reactions are statically indeterminate (allowed: friction = false)")
     c = table_of(raw, "contact", "")
     CONTACT.check_keys(c, "contact")
-    sc["contact"] = {k: CONTACT.read(c, k, "contact") for k in
-                     ("mu_static", "mu_dynamic", "v_eps", "k0", "eps", "slider_width",
-                      "springs_per_quarter", "radial_gap", "moment_model", "seat_stiffness",
-                      "friction_load")}
+    sc["contact"] = {k: CONTACT.read(c, k, "contact", **(
+                         {"default": "couple" if boom_tables else "rigid"}
+                         if k == "moment_model" else {}))
+                     for k in ("mu_static", "mu_dynamic", "v_eps", "k0", "eps", "slider_width",
+                               "springs_per_quarter", "radial_gap", "moment_model",
+                               "seat_stiffness", "friction_load")}
     cc = sc["contact"]
     if cc["friction_load"] == "springs" and not eff["contact_distribution"]:
         raise SceneError("contact.friction_load = 'springs' with effects.contact_distribution = "
@@ -617,6 +673,17 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
         if lo < 0.1:
             raise SceneError(f"hoist_drive: the hoist rope's length drops to {lo:.4g} m (allowed: "
                              "at least 0.1 m)")
+    gr = table_of(raw, "ground", "")
+    GROUND.check_keys(gr, "ground")
+    if gr and not eff["ground"]:
+        raise SceneError("[ground] with effects.ground = false: the table configures the ground "
+                         "(allowed: effects.ground = true, or leave it out)")
+    if eff["ground"]:
+        if not eff["payload_swing"]:
+            raise SceneError("effects.ground = true with effects.payload_swing = false: the ground "
+                             "carries the payload that hangs on the hoist rope (allowed: "
+                             "effects.payload_swing = true)")
+        sc["ground"] = GROUND.resolve(raw, "ground")
     oc = table_of(raw, "oil_column", "")
     OIL_COLUMN.check_keys(oc, "oil_column")
     if oc and not eff["oil_column"]:
@@ -1063,6 +1130,7 @@ def params_from_scene(sc: dict):
         **profiles, payload_swing=sc["effects"].get("payload_swing", False),
         hoist_length=hoist.get("length", 10.0), hoist_EA=hoist.get("EA", 2e8),
         hook_mass=hoist.get("hook_mass", 500.0),
+        ground=sc.get("ground") if sc["effects"].get("ground") else None,
         oil_column=sc.get("oil_column"),
         booms=booms, overlaps=overlaps, luffing=luffing,
         n_booms=b["count"], boom_length=b.get("length", booms[0].length if booms else 10.0),
@@ -1072,7 +1140,7 @@ def params_from_scene(sc: dict):
         gravity=sc["gravity"]["g"] if sc["effects"]["gravity"] else 0.0, n_nodes=b["n_nodes"],
         n_gauss=b["n_gauss"], filter_h=sc["filtering"]["h"] if sc["effects"]["filtering"] else 0.0,
         v_max=d["v_max"], t_ramp=d["t_ramp"], t_hold_end=d["t_hold_end"],
-        mechanism=d["mechanism"],
+        mechanism=d["mechanism"], **telescoping.stage_params(sc),
         friction=sc["effects"]["friction"], mu_static=sc["contact"]["mu_static"],
         mu_dynamic=sc["contact"]["mu_dynamic"], v_eps=sc["contact"]["v_eps"],
         spring_k0=sc["contact"]["k0"], spring_eps=sc["contact"]["eps"],
@@ -1085,4 +1153,5 @@ def params_from_scene(sc: dict):
         friction_load=sc["contact"]["friction_load"],
         torsion=sc["effects"]["torsion"], rope_elasticity=sc["effects"]["rope_elasticity"],
         flexible=sc["effects"]["flexible"],
-        mass_centre_offset=sc["effects"]["mass_centre_offset"])
+        mass_centre_offset=sc["effects"]["mass_centre_offset"],
+        f_y=sc.get("material", {}).get("f_y", 355e6))

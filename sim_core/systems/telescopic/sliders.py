@@ -10,6 +10,10 @@ docs/model.md#input-springs: the contact circle at mid-gap).  An arc of opening 
 40 on the half circle), a face carries ``springs_per_quarter``.  The inner region (boom k's inner
 contact section, the slider on boom k+1) and the outer region (boom k+1's outer contact section,
 the slider on boom k) share the surface and differ in k_t (Eq. 61).
+
+A slider is one pad: :func:`overlap_pads` sums its springs (both ends, every patch) into the
+force and couple it puts on the overlap's inner boom, the outputs ``pad_forces``,
+``pad_couples`` and ``pad_face_forces``.
 """
 
 from __future__ import annotations
@@ -20,7 +24,8 @@ import numpy as np
 
 from sim_core.physics.contact import SliderGeometry
 
-__all__ = ["bearing_patches", "patches_hold", "slider_geometries", "family_region"]
+__all__ = ["bearing_patches", "patches_hold", "slider_geometries", "family_region", "pad_loads",
+           "PAD_NAMES", "overlap_pads"]
 
 _U_DEFAULT = ("P1", "P2", "P3")          # the paper's bearing arcs (Section 8.2, Fig. 8)
 
@@ -115,3 +120,52 @@ def slider_geometries(p) -> list[tuple[SliderGeometry, SliderGeometry]]:
                                         faces=faces)
                          for kind, kt in (("inner", -1), ("outer", 1))))
     return out
+
+
+#: the two pads of an overlap in the order of the pad outputs: the outer boom's pad at its outer
+#: (right) end, region II, and the inner boom's pad at its inner (left) end, region I
+PAD_NAMES = ("outer pad", "inner pad")
+
+
+def pad_loads(geom: SliderGeometry, normal_force) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The load one pad (one slider, all its springs at both ends x = +-w and on every patch)
+    puts on the inner boom of its overlap, in the contact section's frame (e_t lateral, e_b
+    vertical in the luffing plane; Section 8.3):
+
+    * force (2,) (f_t, f_b), N: minus the sum of the spring forces along the patches' outward
+      normals, -sum f_ij n_ij (Eq. 64: a spring pushes the inner boom's face inwards whichever
+      boom the contact section belongs to, k_t n_ij f_ij on the slider of either region);
+    * couple (2,) (m_t, m_b), N m: the moment about the pad's centre that the springs carry as
+      a force pair across the pad's length, sum of k_s w e_s x (-f_ij n_ij);
+    * per-patch normal force (n_patches,), N >= 0: the springs' sum on each patch (arc or
+      face) in the order of ``geom.arc_index``.
+
+    ``normal_force``: the springs' forces f_ij >= 0 (ContactSolution.normal_force), N."""
+    f = np.asarray(normal_force, dtype=float)
+    F = -(f[:, None] * geom.normals[:, 1:])             # (t, b) on the inner boom, per spring
+    xs = geom.positions[:, 0]                            # k_s w, m
+    couple = np.array([-xs @ F[:, 1], xs @ F[:, 0]])     # (e_s x F) k_s w: t and b components
+    n_patch = int(geom.arc_index.max()) + 1
+    return F.sum(axis=0), couple, np.bincount(geom.arc_index, weights=f, minlength=n_patch)
+
+
+def overlap_pads(contact, sols) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The pads of every overlap from the slider springs of every region (:func:`pad_loads`):
+    forces (n_overlaps, 2, 2) N, couples (n_overlaps, 2, 2) N m and per-patch normal forces
+    (n_overlaps, 2, n_patches) N (NaN-padded to the largest patch count), pads in the order
+    of :data:`PAD_NAMES` (the outer pad, region II; the inner pad, region I).
+
+    ``contact``: the system's ContactFriction with the distribution on; ``sols``: its
+    ``solve_regions`` at one state (regions I_12, II_12, I_23, ...)."""
+    loads = [pad_loads(geo, sol.normal_force)
+             for (_, _, _, geo), (_, _, _, sol) in zip(contact.regions, sols)]
+    n_ov = len(loads) // 2
+    order = [(2 * k + 1, 2 * k) for k in range(n_ov)]           # (II, I) of overlap k
+    n_patch = max(p.size for _, _, p in loads)
+    faces = np.full((n_ov, 2, n_patch), np.nan)
+    for k, pair in enumerate(order):
+        for j, r in enumerate(pair):
+            faces[k, j, :loads[r][2].size] = loads[r][2]
+    return (np.array([[loads[r][0] for r in pair] for pair in order]).reshape(n_ov, 2, 2),
+            np.array([[loads[r][1] for r in pair] for pair in order]).reshape(n_ov, 2, 2),
+            faces)
