@@ -240,6 +240,17 @@ def _schedule(path, key: str, entry: dict, data: dict):
                                "unpickling")
 
 
+def _finite(path, key: str, value) -> float:
+    """A finite number from a JSON field (SB3 writes some as text)."""
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        x = float("nan")
+    if not np.isfinite(x):
+        raise ModelFileError(path, f"data entry {key!r}: {value!r:.40} is not a finite number")
+    return x
+
+
 def sb3_custom_objects(data: dict, path="model") -> dict:
     """``custom_objects`` for SB3's ``load`` holding a value for every cloudpickled entry of a
     model's ``data`` JSON (so that SB3 unpickles none)."""
@@ -259,6 +270,12 @@ def sb3_custom_objects(data: dict, path="model") -> dict:
             out[key] = allowed[m.group(1)]
         elif key in ("lr_schedule", "clip_range", "clip_range_vf", "exploration_schedule"):
             out[key] = _schedule(path, key, entry, data)
+        elif str(entry.get(":type:", "")).endswith(".ConstantSchedule'>"):
+            out[key] = _finite(path, key, entry.get("val"))   # a constant-schedule hyper-parameter
+        elif key == "train_freq":
+            # TrainFreq(frequency, unit) is in the pickle only; acting does not use it, so it
+            # loads as every step (pass custom_objects={"train_freq": ...} to train on)
+            out[key] = 1
         else:                   # last observations, episode buffers, noise: rebuilt by learn()
             out[key] = None
     return out

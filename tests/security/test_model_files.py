@@ -177,3 +177,14 @@ def test_the_committed_model_acts_as_sb3_loads_it():
     # the evaluation's policy finds the JSON statistics beside the model
     pol = PPOPolicy(MODEL)
     assert pol.obs_rms is not None and pol.clip_obs == 10.0
+
+
+def test_a_constant_schedule_hyper_parameter_loads_as_its_value():
+    """RL Zoo saves SAC's learning_rate as a cloudpickled ConstantSchedule; the loader takes its
+    value from the JSON field beside the pickle (so SB3 rebuilds its schedule) and unpickles
+    nothing; a payload in its ``:serialized:`` field is never read."""
+    entry = {":type:": "<class 'stable_baselines3.common.utils.ConstantSchedule'>",
+             ":serialized:": "not base64 at all", "val": "0.00073"}
+    assert mi.sb3_custom_objects({"learning_rate": entry}) == {"learning_rate": 0.00073}
+    with pytest.raises(mi.ModelFileError):
+        mi.sb3_custom_objects({"learning_rate": {**entry, "val": "__import__('os')"}})
