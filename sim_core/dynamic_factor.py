@@ -46,9 +46,9 @@ from sim_core.errors import SceneError
 from sim_core.result import Result, atomic_write_bytes
 from sim_core.sweep import (
     RESULT_FILE,
-    SweepError,
     _write_case,
     csv_bytes,
+    out_folder,
     grid_cases,
     prepare_cases,
     run_case,
@@ -229,11 +229,7 @@ def dynamic_factor(scene, grid: dict, out, *, fixed: dict | None = None, slack: 
         serial = importlib.util.find_spec("ray") is None
     rows = []
     if serial:
-        try:
-            out.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise SweepError(f"--out {str(out)!r}: cannot create the folder: "
-                             f"{exc.strerror}") from None
+        out_folder(out)
         for case in prepare_cases(scene, cases, fixed):
             rec = run_case(case["scene"])
             _write_case(out, case, rec, False)

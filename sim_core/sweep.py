@@ -422,6 +422,19 @@ def _cell(v) -> str:
     return str(v)
 
 
+def out_folder(out) -> Path:
+    """The sweep's output folder, created where missing; SweepError naming ``--out`` for a file
+    or a folder that cannot be created."""
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise SweepError(f"--out {str(out)!r}: is a file, not a folder")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise SweepError(f"--out {str(out)!r}: cannot create the folder: {exc.strerror}") from None
+    return out
+
+
 def csv_bytes(rows: list[dict], fields: list[str], cell) -> bytes:
     """The rows as CSV text (a header of ``fields``, then each row's ``cell(value)`` of every
     field), encoded UTF-8."""
@@ -639,13 +652,7 @@ def run_sweep(scene: str | Path, grid: dict[str, list] | None, out: str | Path, 
     case_list = [dict(c) for c in cases] if cases is not None else grid_cases(grid or {})
     keys = list(grid) if cases is None else list(dict.fromkeys(k for c in case_list for k in c))
     prepared = prepare_cases(scene, case_list, fixed)          # fail fast: nothing runs yet
-    out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise SweepError(f"--out {str(out)!r}: is a file, not a folder")
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise SweepError(f"--out {str(out)!r}: cannot create the folder: {exc.strerror}") from None
+    out = out_folder(out)
     _remove_stale_temporaries(out)
     name = prepared[0]["scene"]["name"] if prepared else str(scene)
 

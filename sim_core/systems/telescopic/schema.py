@@ -673,22 +673,14 @@ def validate_telescopic(raw: dict, source: str) -> dict[str, Any]:
         if lo < 0.1:
             raise SceneError(f"hoist_drive: the hoist rope's length drops to {lo:.4g} m (allowed: "
                              "at least 0.1 m)")
-    gr = table_of(raw, "ground", "")
-    GROUND.check_keys(gr, "ground")
-    if gr and not eff["ground"]:
-        raise SceneError("[ground] with effects.ground = false: the table configures the ground "
-                         "(allowed: effects.ground = true, or leave it out)")
+    _effect_table(raw, GROUND, eff, "the ground")
     if eff["ground"]:
         if not eff["payload_swing"]:
             raise SceneError("effects.ground = true with effects.payload_swing = false: the ground "
                              "carries the payload that hangs on the hoist rope (allowed: "
                              "effects.payload_swing = true)")
         sc["ground"] = GROUND.resolve(raw, "ground")
-    oc = table_of(raw, "oil_column", "")
-    OIL_COLUMN.check_keys(oc, "oil_column")
-    if oc and not eff["oil_column"]:
-        raise SceneError("[oil_column] with effects.oil_column = false: the table configures the "
-                         "oil column (allowed: effects.oil_column = true, or leave it out)")
+    oc = _effect_table(raw, OIL_COLUMN, eff, "the oil column")
     if eff["oil_column"]:
         sc["oil_column"] = {k: OIL_COLUMN.read(oc, k, "oil_column") for k in
                             ("cylinder_area", "bulk_modulus", "dead_length", "damping_ratio")}
@@ -791,6 +783,18 @@ def _check_modal(sc: dict, ls_lo: float, ls_hi: float, L_lo: float, L_hi: float)
                      f"{key} = {getattr(p, attr)!r}")
             raise SceneError(f"{shown}: the modal tables are built for {key} = "
                              f"{getattr(ref, attr)!r} (other values: model.reduction = 'none')")
+
+
+def _effect_table(raw: dict, T: Table, eff: dict, what: str) -> dict:
+    """The table ``T`` of the effect of the same name, its keys checked; a SceneError where it
+    is given with the effect off."""
+    name = T.path
+    t = table_of(raw, name, "")
+    T.check_keys(t, name)
+    if t and not eff[name]:
+        raise SceneError(f"[{name}] with effects.{name} = false: the table configures {what} "
+                         f"(allowed: effects.{name} = true, or leave it out)")
+    return t
 
 
 def _check_actuator(d: dict, table: str) -> dict:
